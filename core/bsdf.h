@@ -1,0 +1,72 @@
+// BSDF interface, templated on the channel count N (3: RGB, 16: latent). All directions are in
+// the local shading frame (normal = +z) and point away from the surface: wi toward where the
+// path came from, wo the scattered direction. Values are signed-safe: nothing here may assume
+// reflectance >= 0 (latent reflectances cross zero), and sampling depends only on geometry and
+// roughness, never on the sign or size of the spectral coefficients. Equations: docs/bsdfs.md.
+#pragma once
+#include "core/geometry.h"
+#include "core/props.h"
+#include "core/spectrum.h"
+#include <cstdint>
+#include <memory>
+
+namespace lpt {
+
+enum BSDFFlags : uint32_t {
+    kNoLobe = 0,
+    kDiffuseReflection = 1u << 0,
+    kGlossyReflection = 1u << 1,
+    kDeltaReflection = 1u << 2,
+    kGlossyTransmission = 1u << 3,
+    kDeltaTransmission = 1u << 4,
+    kDelta = kDeltaReflection | kDeltaTransmission,
+    kTransmission = kGlossyTransmission | kDeltaTransmission,
+    kNonDelta = kDiffuseReflection | kGlossyReflection | kGlossyTransmission,
+};
+
+/// Radiance: camera paths (the only mode the renderer uses); Importance: light paths, where
+/// refraction does not rescale by 1/eta^2 (Veach's non-symmetric BSDF adjoint).
+enum class TransportMode { Radiance, Importance };
+
+struct BSDFContext {
+    TransportMode mode = TransportMode::Radiance;
+    Vec2f uv = Vec2f::Zero();  ///< surface uv, for textured parameters
+};
+
+template <int N>
+struct BSDFSample {
+    Vec3f wo = Vec3f::Zero();
+    /// Solid-angle pdf of wo for non-delta lobes; for a delta lobe, the discrete probability of
+    /// having chosen that lobe. 0 marks a failed sample.
+    float pdf = 0.f;
+    float eta = 1.f;            ///< relative IOR across the interface for a transmission, else 1
+    uint32_t lobe = kNoLobe;    ///< the single BSDFFlags bit of the sampled lobe
+    Spectrum<N> weight = Spectrum<N>::Zero();  ///< f * |cos wo| / pdf (delta: the lobe's value / pdf)
+    bool valid() const { return pdf > 0.f; }
+};
+
+template <int N>
+class BSDF {
+public:
+    virtual ~BSDF() = default;
+    /// f(wi, wo) * |cos wo| over the non-delta lobes (delta lobes evaluate to zero).
+    virtual Spectrum<N> eval(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const = 0;
+    /// Solid-angle density with which sample() produces wo, over the non-delta lobes.
+    virtual float pdf(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const = 0;
+    /// u1 picks a lobe, u2 the direction.
+    virtual BSDFSample<N> sample(const BSDFContext& ctx, const Vec3f& wi, float u1, const Vec2f& u2) const = 0;
+    /// OR of the lobes this BSDF can produce.
+    virtual uint32_t flags() const = 0;
+    /// Hemispherical reflectance-like colour for the albedo AOV (not an integral; a display value).
+    virtual Spectrum<N> albedo(const BSDFContext& ctx) const = 0;
+
+    bool has_delta() const { return (flags() & kDelta) != 0; }
+    bool is_delta() const { return (flags() & kNonDelta) == 0; }
+};
+
+/// Builds a BSDF from its description (explicit type table in core/bsdfs/registry.cpp).
+/// Unknown types and bad values throw SceneError naming props.file and the field.
+template <int N>
+std::unique_ptr<BSDF<N>> make_bsdf(const Props& props);
+
+}  // namespace lpt

@@ -1,0 +1,26 @@
+// Input errors that name where the bad input is: file, field (JSON pointer / XML path) and,
+// when known, the line. Every loader throws SceneError; apps print what() and exit non-zero.
+#pragma once
+#include <stdexcept>
+#include <string>
+
+namespace lpt {
+
+class SceneError : public std::runtime_error {
+public:
+    SceneError(const std::string& file, const std::string& field, const std::string& message, int line = -1)
+        : std::runtime_error(format(file, field, message, line)), m_file(file), m_field(field) {}
+    const std::string& file() const { return m_file; }
+    const std::string& field() const { return m_field; }
+
+private:
+    static std::string format(const std::string& file, const std::string& field, const std::string& msg, int line) {
+        std::string s = file;
+        if (line >= 0) s += ":" + std::to_string(line);
+        if (!field.empty()) s += ": field '" + field + "'";
+        return s + ": " + msg;
+    }
+    std::string m_file, m_field;
+};
+
+}  // namespace lpt

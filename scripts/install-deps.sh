@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs every Debian package latentpt needs (idempotent). Run as root or with sudo.
+# Package choices and pitfalls: ../shared/BUILD-NOTES.md
+#  - openimageio-tools: OpenImageIO's CMake config fails without its binaries.
+#  - libopenblas0-pthread: otherwise libtorch matrix products fall back to reference BLAS.
+set -euo pipefail
+pkgs=(
+  build-essential cmake ninja-build ccache pkg-config
+  libembree-dev libeigen3-dev libtbb-dev
+  libtorch-dev libopenblas0-pthread
+  libopenimageio-dev openimageio-tools
+  libtinygltf-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libcli11-dev
+  libgtest-dev libbenchmark-dev
+)
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#pkgs[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
