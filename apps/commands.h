@@ -1,0 +1,50 @@
+// Subcommand entry points. main.cpp owns all command-line parsing (one CLI11 translation unit);
+// each subcommand file receives plain option structs.
+#pragma once
+#include <cstdint>
+#include <map>
+#include <string>
+
+namespace lpt::app {
+
+struct RenderArgs {
+    std::string scene;
+    std::string out = "render.exr";
+    int spp = 0;                  ///< 0 = the scene's
+    std::string res;              ///< "WxH", empty = the scene's
+    uint64_t seed = 0;
+    int max_depth = -2;           ///< -2 = the scene's
+    std::string strategy = "mis";
+    bool aov = false;
+    float exposure = 0.f;
+    std::map<std::string, std::string> defines;
+    bool quiet = false;
+};
+int run_render(const RenderArgs& args);
+
+struct BenchArgs {
+    std::string scene;            ///< empty = the bundled Cornell box
+    int spp = 16;
+    int res = 256;
+    int sphere_triangles = 100000;
+    std::string out_json;         ///< optional machine-readable results
+};
+int run_bench(const BenchArgs& args);
+
+/// Parses "WxH"; throws std::invalid_argument with a clear message.
+void parse_resolution(const std::string& s, int& w, int& h);
+
+/// Prints "\r[label] 45.0% | 12.3 Mrays/s | ETA 3.2 s" to stderr, at most every 0.25 s.
+class Progress {
+public:
+    explicit Progress(std::string label, bool enabled = true);
+    void update(double fraction, uint64_t rays);
+    void finish(uint64_t rays);
+
+private:
+    std::string m_label;
+    bool m_enabled;
+    double m_start, m_last = -1.0;
+};
+
+}  // namespace lpt::app

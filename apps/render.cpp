@@ -1,0 +1,54 @@
+// `latentpt render`: scene → float EXR + sRGB PNG preview (+ AOV EXRs).
+#include "apps/commands.h"
+#include "core/image_io.h"
+#include "core/scene_loader.h"
+#include "integrators/aov.h"
+#include "integrators/path.h"
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+
+namespace lpt::app {
+
+namespace {
+std::string with_suffix(const std::string& exr_path, const std::string& suffix_ext) {
+    std::filesystem::path p(exr_path);
+    return (p.parent_path() / (p.stem().string() + suffix_ext)).string();
+}
+}  // namespace
+
+int run_render(const RenderArgs& a) {
+    Scene scene = load_scene(a.scene, a.defines);
+    SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
+    RenderOptions opt = RenderOptions::from_scene(scene);
+    opt.seed = a.seed;
+    if (a.spp > 0) opt.spp = a.spp;
+    if (a.max_depth != -2) opt.max_depth = a.max_depth;
+    if (!a.res.empty()) parse_resolution(a.res, opt.width, opt.height);
+    opt.strategy = a.strategy == "nee" ? LightStrategy::Nee : a.strategy == "bsdf" ? LightStrategy::Bsdf : LightStrategy::Mis;
+    Progress progress("render", !a.quiet);
+    std::mutex m;
+    opt.progress = [&](double f, uint64_t rays) {
+        std::lock_guard<std::mutex> lock(m);
+        progress.update(f, rays);
+    };
+    RenderStats stats;
+    Film<3> film = render_path<3>(scene, spectra, opt, &stats);
+    progress.finish(stats.rays());
+
+    Image img{film.width(), film.height(), 3, film.develop(), {"R", "G", "B"}};
+    write_exr(a.out, img);
+    write_png_srgb(with_suffix(a.out, ".png"), img, a.exposure);
+    if (a.aov) {
+        AovImages aov = render_aovs(scene, spectra, img.width, img.height, std::min(opt.spp, 16), a.seed);
+        write_exr(with_suffix(a.out, ".normal.exr"), Image{aov.width, aov.height, 3, aov.normal, {"X", "Y", "Z"}});
+        write_exr(with_suffix(a.out, ".distance.exr"), Image{aov.width, aov.height, 1, aov.distance, {"Z"}});
+        write_exr(with_suffix(a.out, ".albedo.exr"), Image{aov.width, aov.height, 3, aov.albedo, {"R", "G", "B"}});
+    }
+    if (!a.quiet)
+        std::cerr << "wrote " << a.out << " and " << with_suffix(a.out, ".png") << " (" << img.width << "x" << img.height << ", " << opt.spp
+                  << " spp, " << stats.rays() << " rays, " << stats.seconds << " s)\n";
+    return 0;
+}
+
+}  // namespace lpt::app

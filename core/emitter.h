@@ -1,0 +1,39 @@
+// Emitters: one-sided area lights attached to shapes, and a constant environment. Their
+// radiance is spectral data (SceneSpectra<N>); this header holds the geometric part that
+// sampling needs, which never depends on learned (signed) radiance. Equations: docs/sampling.md.
+#pragma once
+#include "core/geometry.h"
+#include "core/props.h"
+#include "core/shape.h"
+
+namespace lpt {
+
+enum class EmitterKind { Area, Constant };
+
+struct Emitter {
+    EmitterKind kind = EmitterKind::Area;
+    int shape = -1;                 ///< emitting shape (Area only)
+    Eigen::Array3f radiance_rgb = Eigen::Array3f::Ones();  ///< as described in the scene file
+    Props props;                    ///< the description, for error messages and other N
+};
+
+struct LightSample {
+    Vec3f p = Vec3f::Zero();   ///< point on the light (Area)
+    Vec3f n = Vec3f::UnitZ();  ///< its emission normal
+    Vec3f wi = Vec3f::UnitZ(); ///< unit direction from the reference point toward the light
+    float dist = kInf;         ///< distance to the light point (inf for the environment)
+    float pdf = 0.f;           ///< solid angle at the reference point, light choice included
+    int emitter = -1;
+    bool valid() const { return pdf > 0.f; }
+};
+
+/// Area light: uniform point on the shape, converted to solid angle at `ref`. Zero pdf when the
+/// sample faces away (one-sided emission).
+LightSample sample_area_light(const Shape& shape, const Vec3f& ref, const Eigen::Vector3f& u);
+/// Solid-angle density of reaching light point p (normal n) from ref by sample_area_light.
+float pdf_area_light(const Shape& shape, const Vec3f& ref, const Vec3f& p, const Vec3f& n);
+/// Constant environment: uniform sphere of directions.
+LightSample sample_constant_light(const Vec2f& u);
+float pdf_constant_light();
+
+}  // namespace lpt

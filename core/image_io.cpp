@@ -1,0 +1,90 @@
+#include "core/image_io.h"
+#include <OpenImageIO/imageio.h>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace lpt {
+
+namespace fs = std::filesystem;
+
+namespace {
+std::string temp_path_for(const std::string& path) {
+    fs::path p(path);
+    // Keep the extension last: OIIO chooses the format from it.
+    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + p.extension().string())).string();
+}
+
+void write_oiio(const std::string& path, const OIIO::ImageSpec& spec, const void* data) {
+    if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
+    std::string tmp = temp_path_for(path);
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw std::runtime_error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
+    if (!out->open(tmp, spec) || !out->write_image(spec.format, data) || !out->close()) {
+        std::string err = out->geterror();
+        fs::remove(tmp);
+        throw std::runtime_error(path + ": cannot write image: " + err);
+    }
+    fs::rename(tmp, path);
+}
+}  // namespace
+
+float linear_to_srgb(float v) {
+    v = std::clamp(v, 0.f, 1.f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+
+void write_exr(const std::string& path, const Image& img) {
+    OIIO::ImageSpec spec(img.width, img.height, img.channels, OIIO::TypeDesc::FLOAT);
+    if (!img.channel_names.empty()) {
+        spec.channelnames = img.channel_names;
+    } else if (img.channels > 4) {
+        spec.channelnames.clear();
+        for (int c = 0; c < img.channels; ++c) spec.channelnames.push_back("C" + std::to_string(c));
+    }
+    spec.attribute("compression", "zip");
+    write_oiio(path, spec, img.data.data());
+}
+
+void write_png_srgb(const std::string& path, const Image& img, float exposure) {
+    std::vector<uint8_t> px(size_t(img.width) * img.height * 3);
+    float scale = std::exp2(exposure);
+    for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
+        for (int c = 0; c < 3; ++c) {
+            float v = img.data[i * img.channels + std::min(c, img.channels - 1)] * scale;
+            px[i * 3 + c] = uint8_t(std::lround(255.f * linear_to_srgb(std::isfinite(v) ? v : 0.f)));
+        }
+    OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
+    write_oiio(path, spec, px.data());
+}
+
+Image read_image(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw std::runtime_error(path + ": cannot read image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    Image img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.channels = spec.nchannels;
+    img.channel_names = spec.channelnames;
+    img.data.resize(size_t(img.width) * img.height * img.channels);
+    if (!in->read_image(OIIO::TypeDesc::FLOAT, img.data.data()))
+        throw std::runtime_error(path + ": cannot decode image: " + in->geterror());
+    return img;
+}
+
+void write_text_atomic(const std::string& path, const std::string& contents) {
+    if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
+    std::string tmp = temp_path_for(path);
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        out << contents;
+        if (!out) throw std::runtime_error(path + ": cannot write file");
+    }
+    fs::rename(tmp, path);
+}
+
+}  // namespace lpt

@@ -1,0 +1,27 @@
+// Image files through OpenImageIO. Writes are atomic: the data goes to a temporary file in the
+// destination folder, which is renamed over the target only once complete, so an interrupted
+// run never leaves a truncated image.
+#pragma once
+#include <string>
+#include <vector>
+
+namespace lpt {
+
+struct Image {
+    int width = 0, height = 0, channels = 0;
+    std::vector<float> data;               ///< interleaved, row-major from the top-left
+    std::vector<std::string> channel_names;
+};
+
+/// Float EXR (half=false: 32-bit). Channel names default to R,G,B(,A) or C0..C{n-1}.
+void write_exr(const std::string& path, const Image& img);
+/// 8-bit sRGB PNG preview of the first 3 channels: linear values × 2^exposure, clamped, sRGB OETF.
+void write_png_srgb(const std::string& path, const Image& img, float exposure = 0.f);
+/// Any format OIIO reads; throws std::runtime_error naming the file on failure.
+Image read_image(const std::string& path);
+/// Writes `contents` to path atomically (temp + rename).
+void write_text_atomic(const std::string& path, const std::string& contents);
+
+float linear_to_srgb(float v);
+
+}  // namespace lpt

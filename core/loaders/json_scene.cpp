@@ -1,0 +1,311 @@
+// latentpt's JSON scene format (docs/scene-format.md). Errors name the JSON path of the bad
+// field, e.g. `scene.json: field 'shapes[2].material': unknown material 'whte'`.
+#include "core/bsdf.h"
+#include "core/error.h"
+#include "core/scene_loader.h"
+#include <nlohmann/json.hpp>
+#include <filesystem>
+#include <fstream>
+
+namespace lpt {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Ctx {
+    std::string file;
+    fs::path dir;
+    [[noreturn]] void fail(const std::string& field, const std::string& msg) const { throw SceneError(file, field, msg); }
+
+    float number(const json& j, const std::string& field) const {
+        if (!j.is_number()) fail(field, "expected a number, got " + std::string(j.type_name()));
+        float v = j.get<float>();
+        if (!std::isfinite(v)) fail(field, "value is not finite");
+        return v;
+    }
+    Vec3f vec3(const json& j, const std::string& field) const {
+        if (j.is_number()) return Vec3f::Constant(number(j, field));
+        if (!j.is_array() || j.size() != 3) fail(field, "expected an array of 3 numbers");
+        return Vec3f(number(j[0], field + "[0]"), number(j[1], field + "[1]"), number(j[2], field + "[2]"));
+    }
+    int integer(const json& j, const std::string& field) const {
+        if (!j.is_number_integer()) fail(field, "expected an integer");
+        return j.get<int>();
+    }
+    std::string string(const json& j, const std::string& field) const {
+        if (!j.is_string()) fail(field, "expected a string");
+        return j.get<std::string>();
+    }
+    const json* opt(const json& obj, const char* key) const {
+        auto it = obj.find(key);
+        return it == obj.end() ? nullptr : &*it;
+    }
+
+    Transform transform_op(const json& op, const std::string& field) const {
+        if (!op.is_object() || op.size() != 1) fail(field, "expected one of {\"translate\"|\"scale\"|\"rotate\"|\"lookat\"|\"matrix\": ...}");
+        const auto& [key, v] = *op.items().begin();
+        std::string f = field + "." + key;
+        if (key == "translate") return Transform::translate(vec3(v, f));
+        if (key == "scale") return Transform::scale(vec3(v, f));
+        if (key == "rotate") {
+            if (!v.is_object() || !v.contains("axis") || !v.contains("angle")) fail(f, "expected {\"axis\": [x,y,z], \"angle\": degrees}");
+            Vec3f axis = vec3(v["axis"], f + ".axis");
+            if (axis.norm() == 0.f) fail(f + ".axis", "axis has zero length");
+            return Transform::rotate(axis, number(v["angle"], f + ".angle"));
+        }
+        if (key == "lookat") {
+            if (!v.is_object()) fail(f, "expected {\"origin\", \"target\", \"up\"}");
+            for (const char* k : {"origin", "target", "up"})
+                if (!v.contains(k)) fail(f + "." + k, "missing");
+            try {
+                return Transform::look_at(vec3(v["origin"], f + ".origin"), vec3(v["target"], f + ".target"), vec3(v["up"], f + ".up"));
+            } catch (const std::invalid_argument& e) {
+                fail(f, e.what());
+            }
+        }
+        if (key == "matrix") {
+            if (!v.is_array() || v.size() != 16) fail(f, "expected 16 numbers, row-major");
+            Eigen::Matrix4f m;
+            for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = number(v[i], f + "[" + std::to_string(i) + "]");
+            if (std::abs(m.topLeftCorner<3, 3>().determinant()) < 1e-12f) fail(f, "matrix is singular");
+            return Transform(m);
+        }
+        fail(field, "unknown transform operation '" + key + "'");
+    }
+    /// One op object, or a list of ops applied in order (each later op left-multiplies).
+    Transform transform(const json& j, const std::string& field) const {
+        if (j.is_object()) return transform_op(j, field);
+        if (!j.is_array()) fail(field, "expected a transform object or a list of them");
+        Transform t;
+        for (size_t i = 0; i < j.size(); ++i) t = transform_op(j[i], field + "[" + std::to_string(i) + "]") * t;
+        return t;
+    }
+
+    /// Plugin description: numbers → float, 3-arrays → rgb, objects → nested Props.
+    Props props(const json& j, const std::string& field) const {
+        if (!j.is_object()) fail(field, "expected an object");
+        Props p;
+        p.file = file;
+        p.where = field;
+        if (!j.contains("type")) fail(field + ".type", "missing");
+        p.type = string(j["type"], field + ".type");
+        for (const auto& [k, v] : j.items()) {
+            if (k == "type") continue;
+            std::string f = field + "." + k;
+            if (v.is_boolean()) p.values[k] = v.get<bool>();
+            else if (v.is_number()) p.values[k] = number(v, f);
+            else if (v.is_string()) p.values[k] = v.get<std::string>();
+            else if (v.is_array()) p.values[k] = Eigen::Array3f(vec3(v, f).array());
+            else if (v.is_object()) p.values[k] = std::make_shared<Props>(props(v, f));
+            else fail(f, "unsupported value");
+        }
+        return p;
+    }
+};
+
+void apply_define(json& root, const std::string& key, const std::string& value, const std::string& file) {
+    // "integrator.spp=64": walk the object path, parse the value as JSON (fallback: string).
+    json* node = &root;
+    size_t start = 0;
+    while (true) {
+        size_t dot = key.find('.', start);
+        std::string part = key.substr(start, dot - start);
+        if (dot == std::string::npos) {
+            json v = json::parse(value, nullptr, false);
+            (*node)[part] = v.is_discarded() ? json(value) : v;
+            return;
+        }
+        if (!node->is_object()) throw SceneError(file, key, "cannot override: not an object path");
+        node = &(*node)[part];
+        start = dot + 1;
+    }
+}
+
+}  // namespace
+
+Scene load_scene_json(const std::string& path, const std::map<std::string, std::string>& defines) {
+    Ctx c{path, fs::path(path).parent_path()};
+    std::ifstream in(path);
+    if (!in) throw SceneError(path, "", "cannot open file");
+    json root;
+    try {
+        root = json::parse(in);
+    } catch (const json::parse_error& e) {
+        throw SceneError(path, "", std::string("malformed JSON: ") + e.what());
+    }
+    if (!root.is_object()) c.fail("", "top level must be an object");
+    for (const auto& [k, v] : defines) apply_define(root, k, v, path);
+
+    Scene scene;
+    scene.file = path;
+
+    if (const json* ij = c.opt(root, "integrator")) {
+        auto& s = scene.integrator;
+        if (auto* v = c.opt(*ij, "max_depth")) s.max_depth = c.integer(*v, "integrator.max_depth");
+        if (auto* v = c.opt(*ij, "rr_depth")) s.rr_depth = c.integer(*v, "integrator.rr_depth");
+        if (auto* v = c.opt(*ij, "spp")) s.spp = c.integer(*v, "integrator.spp");
+        if (s.spp < 1) c.fail("integrator.spp", "must be >= 1");
+        if (auto* v = c.opt(*ij, "light_sampling")) {
+            std::string m = c.string(*v, "integrator.light_sampling");
+            if (m == "power") s.light_sampling = LightSampling::Power;
+            else if (m == "area") s.light_sampling = LightSampling::Area;
+            else if (m == "uniform") s.light_sampling = LightSampling::Uniform;
+            else c.fail("integrator.light_sampling", "expected power, area or uniform, got '" + m + "'");
+        }
+    }
+
+    const json* cj = c.opt(root, "camera");
+    if (!cj) c.fail("camera", "missing");
+    {
+        Camera& cam = scene.camera;
+        if (auto* t = c.opt(*cj, "type"); t && c.string(*t, "camera.type") != "perspective")
+            c.fail("camera.type", "unknown camera type '" + t->get<std::string>() + "' (known: perspective)");
+        if (auto* v = c.opt(*cj, "fov")) cam.fov = c.number(*v, "camera.fov");
+        if (!(cam.fov > 0.f && cam.fov < 180.f)) c.fail("camera.fov", "must be in (0, 180) degrees");
+        if (auto* v = c.opt(*cj, "fov_axis")) {
+            std::string a = c.string(*v, "camera.fov_axis");
+            if (a == "x") cam.fov_axis = FovAxis::X;
+            else if (a == "y") cam.fov_axis = FovAxis::Y;
+            else if (a == "smaller") cam.fov_axis = FovAxis::Smaller;
+            else if (a == "larger") cam.fov_axis = FovAxis::Larger;
+            else c.fail("camera.fov_axis", "expected x, y, smaller or larger");
+        }
+        if (auto* v = c.opt(*cj, "to_world")) cam.world_from_camera = c.transform(*v, "camera.to_world");
+        if (auto* v = c.opt(*cj, "width")) cam.width = c.integer(*v, "camera.width");
+        if (auto* v = c.opt(*cj, "height")) cam.height = c.integer(*v, "camera.height");
+        if (cam.width < 1 || cam.height < 1) c.fail("camera.width", "resolution must be positive");
+        if (auto* v = c.opt(*cj, "near_clip")) cam.near_clip = c.number(*v, "camera.near_clip");
+        if (auto* v = c.opt(*cj, "far_clip")) cam.far_clip = c.number(*v, "camera.far_clip");
+        if (auto* f = c.opt(*cj, "filter")) {
+            std::string ft = f->is_object() && f->contains("type") ? c.string((*f)["type"], "camera.filter.type") : "";
+            if (ft == "box") cam.filter = {PixelFilter::Type::Box, 0.5f};
+            else if (ft == "tent") cam.filter = {PixelFilter::Type::Tent, 1.f};
+            else c.fail("camera.filter.type", "expected box or tent");
+            if (auto* r = c.opt(*f, "radius")) cam.filter.radius = c.number(*r, "camera.filter.radius");
+            if (!(cam.filter.radius > 0.f)) c.fail("camera.filter.radius", "must be > 0");
+        }
+    }
+
+    std::map<std::string, int> material_ids;
+    if (const json* mj = c.opt(root, "materials")) {
+        if (!mj->is_object()) c.fail("materials", "expected an object of named materials");
+        for (const auto& [name, m] : mj->items()) {
+            material_ids[name] = int(scene.materials.size());
+            scene.materials.push_back(c.props(m, "materials." + name));
+        }
+    }
+
+    const json* sj = c.opt(root, "shapes");
+    if (!sj || !sj->is_array()) c.fail("shapes", "missing or not an array");
+    for (size_t i = 0; i < sj->size(); ++i) {
+        const json& s = (*sj)[i];
+        std::string f = "shapes[" + std::to_string(i) + "]";
+        if (!s.is_object()) c.fail(f, "expected an object");
+        Shape shape;
+        shape.id = s.contains("id") ? c.string(s["id"], f + ".id") : "shape" + std::to_string(i);
+        if (scene.find_shape(shape.id) >= 0) c.fail(f + ".id", "duplicate shape id '" + shape.id + "'");
+        if (!s.contains("type")) c.fail(f + ".type", "missing");
+        std::string type = c.string(s["type"], f + ".type");
+        if (auto* v = c.opt(s, "face_normals")) {
+            if (!v->is_boolean()) c.fail(f + ".face_normals", "expected a boolean");
+            shape.face_normals = v->get<bool>();
+        }
+        if (type == "obj" || type == "ply" || type == "gltf") {
+            if (!s.contains("filename")) c.fail(f + ".filename", "missing");
+            fs::path mp = c.dir / c.string(s["filename"], f + ".filename");
+            bool flip = s.contains("flip_tex_coords") && s["flip_tex_coords"].is_boolean() && s["flip_tex_coords"].get<bool>();
+            try {
+                shape.mesh = load_mesh_file(mp.string(), flip);
+            } catch (const SceneError& e) {
+                c.fail(f + ".filename", e.what());
+            }
+        } else if (type == "mesh") {
+            const json* pj = c.opt(s, "positions");
+            const json* xj = c.opt(s, "indices");
+            if (!pj || !pj->is_array()) c.fail(f + ".positions", "expected an array of [x,y,z]");
+            if (!xj || !xj->is_array()) c.fail(f + ".indices", "expected an array of [i,j,k] (or polygons, fan-triangulated)");
+            for (size_t k = 0; k < pj->size(); ++k) shape.mesh.positions.push_back(c.vec3((*pj)[k], f + ".positions[" + std::to_string(k) + "]"));
+            for (size_t k = 0; k < xj->size(); ++k) {
+                std::string ff = f + ".indices[" + std::to_string(k) + "]";
+                const json& poly = (*xj)[k];
+                if (!poly.is_array() || poly.size() < 3) c.fail(ff, "expected a polygon of >= 3 vertex indices");
+                std::vector<uint32_t> vs;
+                for (const auto& x : poly) {
+                    int id = c.integer(x, ff);
+                    if (id < 0 || id >= int(shape.mesh.positions.size()))
+                        c.fail(ff, "vertex index " + std::to_string(id) + " out of range [0, " + std::to_string(shape.mesh.positions.size()) + ")");
+                    vs.push_back(uint32_t(id));
+                }
+                for (size_t t = 1; t + 1 < vs.size(); ++t) shape.mesh.indices.insert(shape.mesh.indices.end(), {vs[0], vs[t], vs[t + 1]});
+            }
+        } else if (type == "rectangle") {
+            shape.mesh = make_rectangle();
+        } else if (type == "cube") {
+            shape.mesh = make_cube();
+        } else if (type == "sphere") {
+            shape.mesh = make_sphere();
+            float r = s.contains("radius") ? c.number(s["radius"], f + ".radius") : 1.f;
+            if (!(r > 0.f)) c.fail(f + ".radius", "must be > 0");
+            Vec3f center = s.contains("center") ? c.vec3(s["center"], f + ".center") : Vec3f::Zero();
+            shape.mesh.transform(Transform::translate(center) * Transform::scale(Vec3f::Constant(r)));
+        } else {
+            c.fail(f + ".type", "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
+        }
+        if (auto* t = c.opt(s, "to_world")) shape.mesh.transform(c.transform(*t, f + ".to_world"));
+        validate_mesh(shape.mesh, path, f, false);
+
+        const json* mat = c.opt(s, "material");
+        if (!mat) c.fail(f + ".material", "missing");
+        if (mat->is_string()) {
+            auto it = material_ids.find(mat->get<std::string>());
+            if (it == material_ids.end()) c.fail(f + ".material", "unknown material '" + mat->get<std::string>() + "'");
+            shape.material = it->second;
+        } else {
+            shape.material = int(scene.materials.size());
+            scene.materials.push_back(c.props(*mat, f + ".material"));
+        }
+        if (const json* ej = c.opt(s, "emitter")) {
+            Props ep = c.props(*ej, f + ".emitter");
+            if (ep.type != "area") c.fail(f + ".emitter.type", "shapes take emitters of type 'area', got '" + ep.type + "'");
+            Emitter e;
+            e.kind = EmitterKind::Area;
+            e.shape = int(scene.shapes.size());
+            e.radiance_rgb = ep.get_rgb("radiance");
+            e.props = ep;
+            shape.emitter = int(scene.emitters.size());
+            scene.emitters.push_back(e);
+        }
+        scene.shapes.push_back(std::move(shape));
+    }
+
+    if (const json* ej = c.opt(root, "emitters")) {
+        if (!ej->is_array()) c.fail("emitters", "expected an array");
+        for (size_t i = 0; i < ej->size(); ++i) {
+            std::string f = "emitters[" + std::to_string(i) + "]";
+            Props ep = c.props((*ej)[i], f);
+            if (ep.type != "constant") c.fail(f + ".type", "top-level emitters must be 'constant' (area lights belong inside a shape), got '" + ep.type + "'");
+            if (scene.environment >= 0) c.fail(f, "only one environment emitter is supported");
+            Emitter e;
+            e.kind = EmitterKind::Constant;
+            e.radiance_rgb = ep.get_rgb("radiance");
+            e.props = ep;
+            scene.environment = int(scene.emitters.size());
+            scene.emitters.push_back(e);
+        }
+    }
+    // Validate every material once, now, so errors point at the file before rendering starts.
+    for (const Props& m : scene.materials) make_bsdf<3>(m);
+    scene.build();
+    return scene;
+}
+
+Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines) {
+    std::string ext = fs::path(path).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower(ch));
+    if (ext == ".json") return load_scene_json(path, defines);
+    throw SceneError(path, "", "unknown scene format '" + ext + "' (known: .json)");
+}
+
+}  // namespace lpt

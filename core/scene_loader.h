@@ -1,0 +1,15 @@
+// Scene files → Scene. `.json` is our format (docs/scene-format.md); Mitsuba 3 `.xml` arrives
+// with its loader. Every error is a SceneError naming the file and the field.
+#pragma once
+#include "core/scene.h"
+#include <map>
+#include <string>
+
+namespace lpt {
+
+/// Loads and build()s a scene. `defines` override scene parameters by name (for XML: <default>;
+/// for JSON: "integrator.spp", "camera.width", ... see docs/scene-format.md).
+Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines = {});
+Scene load_scene_json(const std::string& path, const std::map<std::string, std::string>& defines = {});
+
+}  // namespace lpt

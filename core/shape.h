@@ -1,0 +1,50 @@
+// Shape: a triangle mesh in world space with an id, a material and (optionally) an area
+// emitter. Analytic shapes are tessellated at load time (core/loaders/shapes.cpp), so one
+// code path intersects, samples and differentiates every shape.
+#pragma once
+#include "core/geometry.h"
+#include "core/mesh.h"
+#include <string>
+#include <vector>
+
+namespace lpt {
+
+struct SurfaceInteraction {
+    Vec3f p = Vec3f::Zero();
+    Vec3f ng = Vec3f::UnitZ();  ///< geometric normal (unit), winding-defined side
+    Frame sh;                   ///< shading frame around the interpolated normal
+    Vec2f uv = Vec2f::Zero();
+    float t = kInf;
+    int shape = -1;
+    bool valid() const { return shape >= 0; }
+};
+
+struct PositionSample {
+    Vec3f p, n;        ///< point and its (shading) normal: the side an area light emits to
+    float pdf_area;    ///< density per unit area
+};
+
+class Shape {
+public:
+    std::string id;
+    TriangleMesh mesh;          ///< world space
+    bool face_normals = false;  ///< ignore vertex normals (Mitsuba `face_normals`)
+    int material = -1;          ///< index into Scene::materials
+    int emitter = -1;           ///< index into Scene::emitters, -1 if not emissive
+
+    /// Computes area and the triangle distribution; call after the mesh changes.
+    void prepare();
+    float area() const { return m_area; }
+    /// Uniform by area: u.x() picks the triangle (then is reused), u.y()/u.z() the point.
+    PositionSample sample_position(const Eigen::Vector3f& u) const;
+    /// Hit record from Embree's (primID, u, v, t): barycentrics p = (1-u-v) p0 + u p1 + v p2.
+    SurfaceInteraction interaction(uint32_t prim, float u, float v, float t) const;
+    /// Normal used for emission side and light pdfs at a hit (matches sample_position).
+    Vec3f emission_normal(uint32_t prim, float u, float v) const;
+
+private:
+    std::vector<float> m_cdf;
+    float m_area = 0.f;
+};
+
+}  // namespace lpt

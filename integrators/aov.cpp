@@ -1,0 +1,44 @@
+#include "integrators/aov.h"
+#include "core/sampler.h"
+#include <tbb/parallel_for.h>
+
+namespace lpt {
+
+AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed) {
+    Camera camera = scene.camera.with_resolution(width, height);
+    AovImages out;
+    out.width = width;
+    out.height = height;
+    out.normal.assign(size_t(width) * height * 3, 0.f);
+    out.distance.assign(size_t(width) * height, 0.f);
+    out.albedo.assign(size_t(width) * height * 3, 0.f);
+    tbb::parallel_for(0, height, [&](int y) {
+        set_ftz_daz();
+        for (int x = 0; x < width; ++x) {
+            uint32_t pixel = uint32_t(y * width + x);
+            Vec3f n_sum = Vec3f::Zero(), a_sum = Vec3f::Zero();
+            float d_sum = 0.f;
+            for (int s = 0; s < spp; ++s) {
+                SampleStream rng{seed, pixel, uint32_t(s)};
+                Vec2f off = camera.filter.sample(Vec2f(rng.get(dim::kFilter), rng.get(dim::kFilter + 1)));
+                Ray r = camera.generate_ray(Vec2f(x + 0.5f + off.x(), y + 0.5f + off.y()));
+                SurfaceInteraction si = scene.intersect(r);
+                if (!si.valid()) continue;
+                n_sum += si.sh.n;
+                d_sum += si.t;
+                BSDFContext ctx;
+                ctx.uv = si.uv;
+                a_sum += spectra.bsdf_of(scene, si.shape).albedo(ctx).matrix();
+            }
+            float inv = 1.f / float(spp);
+            for (int c = 0; c < 3; ++c) {
+                out.normal[pixel * 3 + c] = n_sum[c] * inv;
+                out.albedo[pixel * 3 + c] = a_sum[c] * inv;
+            }
+            out.distance[pixel] = d_sum * inv;
+        }
+    });
+    return out;
+}
+
+}  // namespace lpt

@@ -1,0 +1,20 @@
+// Arbitrary output variables of the first camera hit, at any resolution (the refiner wants them
+// at latent resolution): world shading normal, distance along the camera ray (0 on a miss) and
+// albedo. Averaged over `spp` filter samples per pixel with the renderer's random numbers.
+#pragma once
+#include "core/scene.h"
+#include "core/scene_spectra.h"
+#include <vector>
+
+namespace lpt {
+
+struct AovImages {
+    int width = 0, height = 0;
+    std::vector<float> normal;    ///< 3 per pixel, world space, averaged (not renormalised)
+    std::vector<float> distance;  ///< 1 per pixel
+    std::vector<float> albedo;    ///< 3 per pixel
+};
+
+AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed);
+
+}  // namespace lpt

@@ -1,0 +1,44 @@
+// Wavefront unidirectional path tracer, primal only, templated on the channel count N.
+// Next-event estimation and BSDF sampling combined by the power heuristic (docs/transport.md).
+// Output is a pure function of (scene, spectra, options): per-pixel deterministic random numbers
+// and per-tile ownership of pixels make it independent of the thread count.
+#pragma once
+#include "core/film.h"
+#include "core/scene.h"
+#include "core/scene_spectra.h"
+#include <cstdint>
+#include <functional>
+
+namespace lpt {
+
+/// Which estimator collects light: both combined (MIS), or one alone (for tests/debugging).
+enum class LightStrategy { Mis, Nee, Bsdf };
+
+struct RenderOptions {
+    uint64_t seed = 0;
+    int spp = 16;
+    int width = 0, height = 0;   ///< 0 = the camera's resolution
+    int max_depth = 8;           ///< Mitsuba semantics: 1 = emitters seen directly; -1 = unbounded
+    int rr_depth = 5;
+    LightStrategy strategy = LightStrategy::Mis;
+    /// Called now and then with (fraction done, rays traced so far); from a worker thread.
+    std::function<void(double, uint64_t)> progress;
+    static RenderOptions from_scene(const Scene& scene);
+};
+
+struct RenderStats {
+    uint64_t camera_rays = 0, extension_rays = 0, shadow_rays = 0;
+    double seconds = 0.0;
+    uint64_t rays() const { return camera_rays + extension_rays + shadow_rays; }
+};
+
+template <int N>
+Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& options, RenderStats* stats = nullptr);
+
+/// Power heuristic (beta = 2) of sampling technique a against b (both as solid-angle pdfs).
+inline float mis_power(float pdf_a, float pdf_b) {
+    float a2 = pdf_a * pdf_a, b2 = pdf_b * pdf_b;
+    return a2 > 0.f ? a2 / (a2 + b2) : 0.f;
+}
+
+}  // namespace lpt

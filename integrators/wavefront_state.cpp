@@ -1,0 +1,43 @@
+#include "integrators/wavefront_state.h"
+
+namespace lpt {
+
+void RayArrays::reserve(size_t n) {
+    for (auto* a : {&ox, &oy, &oz, &tnear, &dx, &dy, &dz, &time, &tfar, &ngx, &ngy, &ngz, &u, &v}) a->resize(n);
+    for (auto* a : {&mask, &id, &flags, &prim, &geom, &inst}) a->resize(n);
+}
+
+size_t RayArrays::push(const Vec3f& o, const Vec3f& d, float tmin, float tmax) {
+    if (size == ox.size()) reserve(size ? 2 * size : 1024);
+    size_t i = size++;
+    ox[i] = o.x(); oy[i] = o.y(); oz[i] = o.z();
+    dx[i] = d.x(); dy[i] = d.y(); dz[i] = d.z();
+    tnear[i] = tmin; tfar[i] = tmax; time[i] = 0.f;
+    mask[i] = ~0u; id[i] = unsigned(i); flags[i] = 0;
+    geom[i] = RTC_INVALID_GEOMETRY_ID; inst[i] = RTC_INVALID_GEOMETRY_ID;
+    return i;
+}
+
+void RayArrays::intersect(RTCScene scene, bool coherent) {
+    if (!size) return;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    RTCRayHitNp rh;
+    rh.ray = {ox.data(), oy.data(), oz.data(), tnear.data(), dx.data(), dy.data(), dz.data(), time.data(), tfar.data(), mask.data(), id.data(), flags.data()};
+    rh.hit.Ng_x = ngx.data(); rh.hit.Ng_y = ngy.data(); rh.hit.Ng_z = ngz.data();
+    rh.hit.u = u.data(); rh.hit.v = v.data();
+    rh.hit.primID = prim.data(); rh.hit.geomID = geom.data(); rh.hit.instID[0] = inst.data();
+    rtcIntersectNp(scene, &ctx, &rh, unsigned(size));
+}
+
+void RayArrays::occluded(RTCScene scene) {
+    if (!size) return;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    RTCRayNp r = {ox.data(), oy.data(), oz.data(), tnear.data(), dx.data(), dy.data(), dz.data(), time.data(), tfar.data(), mask.data(), id.data(), flags.data()};
+    rtcOccludedNp(scene, &ctx, &r, unsigned(size));
+}
+
+}  // namespace lpt

@@ -1,0 +1,64 @@
+// Structure-of-arrays state for one wavefront of paths. Ray arrays are laid out exactly as
+// Embree 3's rtcIntersectNp / rtcOccludedNp read them (one 16-byte-aligned array per
+// component), so tracing needs no repacking. Per-path spectra sit contiguously per path
+// (N floats; 16 = two AVX2 registers), scalars in their own arrays.
+#pragma once
+#include "core/geometry.h"
+#include "core/spectrum.h"
+#include <embree3/rtcore.h>
+#include <cstdint>
+#include <vector>
+
+namespace lpt {
+
+template <typename T>
+using AlignedVector = std::vector<T, Eigen::aligned_allocator<T>>;
+
+/// Rays + hits for rtcIntersectNp (hits unused by rtcOccludedNp).
+struct RayArrays {
+    AlignedVector<float> ox, oy, oz, tnear, dx, dy, dz, time, tfar;
+    AlignedVector<unsigned> mask, id, flags;
+    AlignedVector<float> ngx, ngy, ngz, u, v;
+    AlignedVector<unsigned> prim, geom, inst;
+    size_t size = 0;
+
+    void reserve(size_t n);
+    void clear() { size = 0; }
+    /// Appends a ray; returns its index.
+    size_t push(const Vec3f& o, const Vec3f& d, float tmin, float tmax);
+    Vec3f origin(size_t i) const { return Vec3f(ox[i], oy[i], oz[i]); }
+    Vec3f direction(size_t i) const { return Vec3f(dx[i], dy[i], dz[i]); }
+    bool hit(size_t i) const { return geom[i] != RTC_INVALID_GEOMETRY_ID; }
+    bool blocked(size_t i) const { return tfar[i] < 0.f; }  ///< rtcOccludedNp's answer
+
+    void intersect(RTCScene scene, bool coherent);
+    void occluded(RTCScene scene);
+};
+
+/// Per-path state of a wavefront. Slot k is fixed for a path's lifetime; `queue` lists the live
+/// slots in the order of the current RayArrays.
+template <int N>
+struct PathState {
+    AlignedVector<Spectrum<N>> beta;       ///< throughput (signed for latents)
+    AlignedVector<Spectrum<N>> radiance;   ///< accumulated estimate
+    std::vector<uint32_t> pixel, sample;   ///< film pixel and sample index (sampler key)
+    std::vector<float> prev_pdf;           ///< solid-angle pdf of the last BSDF sample (MIS)
+    std::vector<uint8_t> prev_delta;       ///< last scattering was a delta lobe (or camera)
+    AlignedVector<Vec3f> prev_p;           ///< last vertex position (area-light pdf on hits)
+
+    void resize(size_t n) {
+        beta.resize(n); radiance.resize(n); pixel.resize(n); sample.resize(n);
+        prev_pdf.resize(n); prev_delta.resize(n); prev_p.resize(n);
+    }
+};
+
+/// Shadow rays of next-event estimation with the contribution each delivers if unblocked.
+template <int N>
+struct ShadowQueue {
+    RayArrays rays;
+    std::vector<uint32_t> slot;
+    AlignedVector<Spectrum<N>> contribution;
+    void clear() { rays.clear(); slot.clear(); contribution.clear(); }
+};
+
+}  // namespace lpt

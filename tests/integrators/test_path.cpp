@@ -1,0 +1,172 @@
+// Path tracer against mathematics: furnace, form factor, estimator agreement, convergence
+// rate and determinism.
+#include "integrators/path.h"
+#include "scene_fixtures.h"
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <cmath>
+#include <numeric>
+
+using namespace lpt;
+using namespace lpt::test;
+
+namespace {
+
+struct Stats {
+    double mean = 0, stderr_ = 0;
+};
+
+/// Mean over pixels of channel c, and its standard error from the pixel-to-pixel spread
+/// (pixels are independent estimates of the same constant in these scenes).
+Stats pixel_stats(const std::vector<float>& img, int channels, int c) {
+    size_t n = img.size() / channels;
+    double s = 0, s2 = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double v = img[i * channels + c];
+        s += v;
+        s2 += v * v;
+    }
+    double mean = s / n;
+    double var = std::max(0.0, s2 / n - mean * mean);
+    return {mean, std::sqrt(var / (n - 1))};
+}
+
+std::vector<float> render(const Scene& scene, int spp, uint64_t seed, LightStrategy strat = LightStrategy::Mis, int w = 0, int h = 0) {
+    auto spectra = SceneSpectra<3>::from_description(scene);
+    RenderOptions opt = RenderOptions::from_scene(scene);
+    opt.spp = spp;
+    opt.seed = seed;
+    opt.strategy = strat;
+    opt.width = w;
+    opt.height = h;
+    return render_path<3>(scene, spectra, opt).develop();
+}
+
+}  // namespace
+
+TEST(PathTracer, WhiteFurnaceMatchesGeometricSeries) {
+    for (float albedo : {0.f, 0.5f, 0.8f}) {
+        Scene scene = furnace_scene(albedo, 1.f);
+        for (LightStrategy s : {LightStrategy::Mis, LightStrategy::Nee, LightStrategy::Bsdf}) {
+            auto img = render(scene, 64, 1, s);
+            double expected = 1.0 / (1.0 - albedo);
+            for (int c = 0; c < 3; ++c) {
+                Stats st = pixel_stats(img, 3, c);
+                // 4.5 sigma plus 0.2% for float accumulation over long paths.
+                EXPECT_NEAR(st.mean, expected, 4.5 * st.stderr_ + 2e-3 * expected)
+                    << "albedo " << albedo << " strategy " << int(s) << " channel " << c;
+            }
+        }
+    }
+}
+
+TEST(PathTracer, MaxDepthTruncatesFurnaceSeries) {
+    // max_depth = d keeps emission after at most d - 1 bounces: sum_{k<d} a^k.
+    const float a = 0.5f;
+    for (int d : {1, 2, 3}) {
+        Scene scene = furnace_scene(a, 1.f, d);
+        auto img = render(scene, 64, 2);
+        double expected = (1.0 - std::pow(a, d)) / (1.0 - a);
+        Stats st = pixel_stats(img, 3, 0);
+        EXPECT_NEAR(st.mean, expected, 4.5 * st.stderr_ + 1e-4) << "max_depth " << d;
+    }
+}
+
+TEST(PathTracer, DirectLightingMatchesFormFactor) {
+    const float rho = 0.5f, le = 3.f, a = 0.5f, b = 0.3f, h = 1.f;
+    Scene scene = form_factor_scene(rho, le, a, b, h);
+    double expected = rho * le * form_factor_centred_rectangle(a, b, h);
+    for (LightStrategy s : {LightStrategy::Mis, LightStrategy::Nee, LightStrategy::Bsdf}) {
+        auto img = render(scene, 256, 3, s);
+        Stats st = pixel_stats(img, 3, 1);
+        EXPECT_NEAR(st.mean, expected, 4.5 * st.stderr_ + 1e-4 * expected) << "strategy " << int(s);
+        EXPECT_LT(st.stderr_, 0.02 * expected) << "the test would not detect a 10% bias";
+    }
+}
+
+TEST(PathTracer, NeeBsdfAndMisAgreeOnCornellBox) {
+    Scene scene = load_scene(cornell_box_path());
+    const int w = 24, h = 24, blocks = 4;
+    // Block means (4x4 blocks per channel) over independent pixels, for each estimator.
+    auto block_stats = [&](LightStrategy s) {
+        auto img = render(scene, 64, 4, s, w, h);
+        std::vector<Stats> out;
+        for (int by = 0; by < blocks; ++by)
+            for (int bx = 0; bx < blocks; ++bx)
+                for (int c = 0; c < 3; ++c) {
+                    std::vector<float> block;
+                    for (int y = by * h / blocks; y < (by + 1) * h / blocks; ++y)
+                        for (int x = bx * w / blocks; x < (bx + 1) * w / blocks; ++x) block.push_back(img[(y * w + x) * 3 + c]);
+                    out.push_back(pixel_stats(block, 1, 0));
+                }
+        return out;
+    };
+    auto mis = block_stats(LightStrategy::Mis), nee = block_stats(LightStrategy::Nee), bsdf = block_stats(LightStrategy::Bsdf);
+    int failures = 0;
+    for (size_t i = 0; i < mis.size(); ++i) {
+        for (const auto* other : {&nee, &bsdf}) {
+            double diff = std::abs(mis[i].mean - (*other)[i].mean);
+            double sigma = std::hypot(mis[i].stderr_, (*other)[i].stderr_);
+            if (diff > 4.0 * sigma + 1e-4) ++failures;
+        }
+    }
+    // 96 comparisons at 4 sigma: a correct renderer fails none with ~99.4% probability.
+    EXPECT_EQ(failures, 0);
+    // And MIS must not be noisier than BSDF sampling alone on this scene.
+    double se_mis = 0, se_bsdf = 0;
+    for (size_t i = 0; i < mis.size(); ++i) se_mis += mis[i].stderr_, se_bsdf += bsdf[i].stderr_;
+    EXPECT_LT(se_mis, se_bsdf);
+}
+
+TEST(PathTracer, ErrorDecreasesAsInverseSqrtSpp) {
+    const float rho = 0.5f, le = 3.f, a = 0.5f, b = 0.3f, h = 1.f;
+    Scene scene = form_factor_scene(rho, le, a, b, h);
+    double expected = rho * le * form_factor_centred_rectangle(a, b, h);
+    std::vector<double> lx, ly;
+    for (int spp : {4, 16, 64, 256}) {
+        // Average the MSE over several seeds and 32x32 independent pixels so the slope is stable.
+        double mse = 0;
+        for (uint64_t seed = 10; seed < 14; ++seed) {
+            auto img = render(scene, spp, seed, LightStrategy::Bsdf, 32, 32);
+            for (size_t i = 0; i < img.size(); i += 3) mse += (img[i] - expected) * (img[i] - expected);
+        }
+        lx.push_back(std::log(double(spp)));
+        ly.push_back(0.5 * std::log(mse));  // log RMSE
+    }
+    double mx = std::accumulate(lx.begin(), lx.end(), 0.0) / lx.size(), my = std::accumulate(ly.begin(), ly.end(), 0.0) / ly.size();
+    double num = 0, den = 0;
+    for (size_t i = 0; i < lx.size(); ++i) num += (lx[i] - mx) * (ly[i] - my), den += (lx[i] - mx) * (lx[i] - mx);
+    double slope = num / den;
+    EXPECT_NEAR(slope, -0.5, 0.08) << "log-log slope of RMSE vs spp";
+}
+
+TEST(PathTracer, SameSeedSameImageAtAnyThreadCount) {
+    Scene scene = load_scene(cornell_box_path());
+    std::vector<float> one, two;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        one = render(scene, 8, 42, LightStrategy::Mis, 40, 40);
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        two = render(scene, 8, 42, LightStrategy::Mis, 40, 40);
+    }
+    ASSERT_EQ(one.size(), two.size());
+    EXPECT_EQ(0, std::memcmp(one.data(), two.data(), one.size() * sizeof(float)));
+    auto other = render(scene, 8, 43, LightStrategy::Mis, 40, 40);
+    EXPECT_NE(0, std::memcmp(one.data(), other.data(), one.size() * sizeof(float))) << "seed must change the image";
+}
+
+TEST(PathTracer, LatentChannelCountRendersLinearSpectra) {
+    // N = 16 runs the same code; with description-derived spectra every channel is the luminance
+    // of RGB, so in the furnace all 16 channels estimate the same constant.
+    Scene scene = furnace_scene(0.5f, 1.f);
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    RenderOptions opt = RenderOptions::from_scene(scene);
+    opt.spp = 64;
+    auto img = render_path<16>(scene, spectra, opt).develop();
+    for (int c = 0; c < 16; ++c) {
+        Stats st = pixel_stats(img, 16, c);
+        EXPECT_NEAR(st.mean, 2.0, 4.5 * st.stderr_ + 4e-3);
+    }
+}
