@@ -45,7 +45,9 @@ struct Ctx {
 
     Transform transform_op(const json& op, const std::string& field) const {
         if (!op.is_object() || op.size() != 1) fail(field, "expected one of {\"translate\"|\"scale\"|\"rotate\"|\"lookat\"|\"matrix\": ...}");
-        const auto& [key, v] = *op.items().begin();
+        auto first = op.begin();
+        const std::string key = first.key();
+        const json& v = first.value();
         std::string f = field + "." + key;
         if (key == "translate") return Transform::translate(vec3(v, f));
         if (key == "scale") return Transform::scale(vec3(v, f));
@@ -105,6 +107,12 @@ struct Ctx {
     }
 };
 
+/// Turns a surface inside out: reversed winding and negated normals (Mitsuba `flip_normals`).
+void flip_normals(TriangleMesh& m) {
+    for (size_t t = 0; t < m.triangle_count(); ++t) std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
+    for (auto& n : m.normals) n = -n;
+}
+
 void apply_define(json& root, const std::string& key, const std::string& value, const std::string& file) {
     // "integrator.spp=64": walk the object path, parse the value as JSON (fallback: string).
     json* node = &root;
@@ -132,7 +140,7 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
     json root;
     try {
         root = json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // parse_error, and out_of_range for overflowing numbers
         throw SceneError(path, "", std::string("malformed JSON: ") + e.what());
     }
     if (!root.is_object()) c.fail("", "top level must be an object");
@@ -254,6 +262,10 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
             c.fail(f + ".type", "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
         }
         if (auto* t = c.opt(s, "to_world")) shape.mesh.transform(c.transform(*t, f + ".to_world"));
+        if (auto* v = c.opt(s, "flip_normals")) {
+            if (!v->is_boolean()) c.fail(f + ".flip_normals", "expected a boolean");
+            if (v->get<bool>()) flip_normals(shape.mesh);
+        }
         validate_mesh(shape.mesh, path, f, false);
 
         const json* mat = c.opt(s, "material");
