@@ -141,9 +141,19 @@ private:
                 if ((f != 0.f).any()) {
                     bool is_env = m_scene.emitters[ls.emitter].kind == EmitterKind::Constant;
                     float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, wi, wo));
+                    // Aim from the offset origin at the light point itself: reusing ls.wi from the
+                    // un-offset point makes the ray cross the light's plane before tmax and hit
+                    // the light (up to half the NEE energy lost under large, close lights).
                     Vec3f o = offset_ray_origin(si.p, si.ng, ls.wi);
-                    float tmax = is_env ? kInf : (ls.p - o).norm() * (1.f - 1e-4f);
-                    ws.shadow.rays.push(o, ls.wi, 0.f, tmax);
+                    Vec3f dir = ls.wi;
+                    float tmax = kInf;
+                    if (!is_env) {
+                        Vec3f d = ls.p - o;
+                        float dist = d.norm();
+                        dir = d / dist;
+                        tmax = dist * (1.f - 1e-4f);
+                    }
+                    ws.shadow.rays.push(o, dir, 0.f, tmax);
                     ws.shadow.slot.push_back(slot);
                     ws.shadow.contribution.push_back(p.beta[slot] * f * m_spectra.radiance[ls.emitter] * (w / ls.pdf));
                 }

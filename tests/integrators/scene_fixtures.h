@@ -14,7 +14,7 @@ inline Scene furnace_scene(float albedo, float le, int max_depth = -1) {
       "integrator": {"max_depth": )" + std::to_string(max_depth) + R"(, "rr_depth": 3},
       "camera": {"fov": 60, "width": 8, "height": 8, "to_world": {"lookat": {"origin": [0,0,0], "target": [0,0,1], "up": [0,1,0]}}},
       "materials": {"wall": {"type": "diffuse", "reflectance": )" + a + R"(}},
-      "shapes": [{"id": "shell", "type": "sphere", "material": "wall", "to_world": {"scale": -1},
+      "shapes": [{"id": "shell", "type": "sphere", "material": "wall", "flip_normals": true,
                   "emitter": {"type": "area", "radiance": )" + l + R"(}}]
     })";
     return load_scene(write_temp_file("furnace.json", json));
@@ -27,7 +27,7 @@ inline Scene form_factor_scene(float rho, float le, float a, float b, float h) {
     auto s = [](float v) { return std::to_string(v); };
     std::string json = R"({
       "integrator": {"max_depth": 2, "rr_depth": 100},
-      "camera": {"fov": 0.5, "width": 8, "height": 8, "filter": {"type": "box"},
+      "camera": {"fov": 0.5, "width": 8, "height": 8, "filter": {"type": "box"}, "near_clip": 1e-4,
                  "to_world": {"lookat": {"origin": [0,0,)" + s(h / 2) + R"(], "target": [0,0,0], "up": [0,1,0]}}},
       "materials": {"plane": {"type": "diffuse", "reflectance": )" + s(rho) + R"(},
                     "black": {"type": "diffuse", "reflectance": 0}},
