@@ -1,0 +1,62 @@
+// Isotropic microfacet distributions (Beckmann, GGX) for the rough plugins: D, Smith G1/G and
+// microfacet-normal sampling with its pdf.
+//   - GGX samples the distribution of visible normals (Heitz 2018, "Sampling the GGX
+//     Distribution of Visible Normals"), pdf D_wi(m) = G1(wi,m) max(0, wi.m) D(m) / cos wi.
+//   - Beckmann samples D(m) cos(theta_m) (Walter et al. 2007, classic), pdf D(m) cos(theta_m);
+//     simpler than Beckmann VNDF and exact, at the price of more variance at grazing wi.
+// Smith G1 is exact for both (Beckmann via erfc, not Walter's rational fit).
+// Keys (read by read_distribution / read_alpha): distribution "beckmann"|"ggx" (default
+// beckmann, as Mitsuba 3); alpha (float, default 0.1, > 0; roughness = RMS slope for Beckmann;
+// values below 1e-4 are raised to 1e-4 as in Mitsuba 3). Equations: docs/bsdfs.md (5)-(12).
+#pragma once
+#include "core/geometry.h"
+#include "core/props.h"
+
+namespace lpt {
+
+enum class MicrofacetType { Beckmann, GGX };
+
+class MicrofacetDistribution {
+public:
+    MicrofacetDistribution(MicrofacetType type, float alpha);
+    MicrofacetType type() const { return m_type; }
+    float alpha() const { return m_alpha; }
+
+    /// Normal distribution D(m), normalised so that ∫ D(m) cos(theta_m) dm = 1; 0 for m.z <= 0.
+    /// docs/bsdfs.md (5), (6)
+    float D(const Vec3f& m) const;
+    /// Smith monostatic shadowing-masking; 0 when v sees the back of m (sign(v.m) != sign(v.z)).
+    /// docs/bsdfs.md (7)
+    float G1(const Vec3f& v, const Vec3f& m) const;
+    /// Separable Smith G(wi, wo, m) = G1(wi, m) G1(wo, m).  docs/bsdfs.md (7)
+    float G(const Vec3f& wi, const Vec3f& wo, const Vec3f& m) const { return G1(wi, m) * G1(wo, m); }
+
+    /// Samples a microfacet normal (upper hemisphere) for wi in the upper hemisphere (callers
+    /// flip wi to the +z side). docs/bsdfs.md (8), (9)
+    Vec3f sample(const Vec3f& wi, const Vec2f& u) const;
+    /// Density of sample() over m (solid angle).  docs/bsdfs.md (8), (9)
+    float pdf(const Vec3f& wi, const Vec3f& m) const;
+    /// f |cos wo| / pdf of a microfacet-sampled wo, without the Fresnel and colour factors:
+    /// G1(wo, m) for GGX-VNDF, G |wi.m| / (|cos wi| cos theta_m) for Beckmann.
+    /// Valid for reflection and refraction alike (the Jacobians cancel).  docs/bsdfs.md (12)
+    float sample_weight(const Vec3f& wi, const Vec3f& wo, const Vec3f& m) const;
+
+private:
+    MicrofacetType m_type;
+    float m_alpha;
+};
+
+/// "distribution" key; unknown names throw SceneError naming the field.
+MicrofacetType read_distribution(const Props& props);
+/// "alpha" key (default 0.1); <= 0 or anisotropic keys (alpha_u/alpha_v) throw SceneError.
+float read_alpha(const Props& props);
+
+/// Mirror reflection of w about m (both pointing away from the surface).
+inline Vec3f reflect(const Vec3f& w, const Vec3f& m) { return 2.f * w.dot(m) * m - w; }
+/// Refraction of w through the interface with normal m, given the signed transmitted cosine and
+/// eta_ti from fresnel_dielectric(w.m, eta).  docs/bsdfs.md (2)
+inline Vec3f refract(const Vec3f& w, const Vec3f& m, float cos_t, float eta_ti) {
+    return m * (w.dot(m) * eta_ti + cos_t) - w * eta_ti;
+}
+
+}  // namespace lpt

@@ -1,0 +1,72 @@
+// "roughconductor": Cook-Torrance microfacet metal (Walter et al. 2007), one-sided (zero unless
+// cos wi > 0 and cos wo > 0, as Mitsuba 3's roughconductor).
+// Keys: distribution ("beckmann" | "ggx", default beckmann as Mitsuba 3); alpha (float, default
+// 0.1, > 0, isotropic); specular_reflectance (rgb, default 1); eta, k, material as "conductor":
+// neither eta nor k (or material "none") is a perfect F = 1 conductor. That is also what
+// Mitsuba 3's code does (material defaults to "none" → eta 0, k 1), although Mitsuba's docs and
+// Mitsuba 0.6 name copper as the default; copper needs an IOR database, which we do not ship.
+// Equations: docs/bsdfs.md (10), (12), (15)-(16).
+#include "core/bsdf.h"
+#include "core/bsdfs/fresnel.h"
+#include "core/bsdfs/microfacet.h"
+
+namespace lpt {
+namespace {
+
+template <int N>
+class RoughConductor final : public BSDF<N> {
+public:
+    explicit RoughConductor(const Props& props)
+        : m_distr(read_distribution(props), read_alpha(props)),
+          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
+          m_ior(read_conductor_ior<N>(props)) {}
+
+    Spectrum<N> eval(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
+        if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
+        Vec3f h = (wi + wo).normalized();
+        float value = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_theta(wi));  // docs/bsdfs.md (15)
+        if (value == 0.f) return Spectrum<N>::Zero();
+        return m_specular * m_ior.fresnel(wi.dot(h)) * value;
+    }
+
+    float pdf(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
+        if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return 0.f;
+        Vec3f h = (wi + wo).normalized();
+        return m_distr.pdf(wi, h) / (4.f * wo.dot(h));  // docs/bsdfs.md (10), (16)
+    }
+
+    BSDFSample<N> sample(const BSDFContext&, const Vec3f& wi, float, const Vec2f& u2) const override {
+        BSDFSample<N> bs;
+        if (cos_theta(wi) <= 0.f) return bs;
+        Vec3f m = m_distr.sample(wi, u2);
+        Vec3f wo = reflect(wi, m);
+        float wo_m = wo.dot(m);
+        if (cos_theta(wo) <= 0.f || wo_m <= 0.f) return bs;
+        float pdf = m_distr.pdf(wi, m) / (4.f * wo_m);
+        if (!(pdf > 0.f) || !std::isfinite(pdf)) return bs;
+        bs.wo = wo;
+        bs.pdf = pdf;
+        bs.lobe = kGlossyReflection;
+        bs.weight = m_specular * m_ior.fresnel(wi.dot(m)) * m_distr.sample_weight(wi, wo, m);  // (12)
+        return bs;
+    }
+
+    uint32_t flags() const override { return kGlossyReflection; }
+    Spectrum<N> albedo(const BSDFContext&) const override { return m_specular * m_ior.fresnel(1.f); }
+
+private:
+    MicrofacetDistribution m_distr;
+    Spectrum<N> m_specular;
+    ConductorIOR<N> m_ior;
+};
+
+}  // namespace
+
+template <int N>
+std::unique_ptr<BSDF<N>> make_roughconductor_bsdf(const Props& props) {
+    return std::make_unique<RoughConductor<N>>(props);
+}
+template std::unique_ptr<BSDF<3>> make_roughconductor_bsdf<3>(const Props&);
+template std::unique_ptr<BSDF<16>> make_roughconductor_bsdf<16>(const Props&);
+
+}  // namespace lpt
