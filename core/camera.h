@@ -29,7 +29,9 @@ public:
 
     /// Ray through continuous film position (pixels). Direction is unit length; tmin/tmax are the
     /// clip distances along it.
-    Ray generate_ray(const Vec2f& film_pos) const;
+    Ray generate_ray(const Vec2f& film_pos) const { return generate_ray(film_pos, tan_half_fov()); }
+    /// Same, with tan_half_fov() computed once by the caller (it costs a tan per ray otherwise).
+    Ray generate_ray(const Vec2f& film_pos, const Vec2f& tan_half) const;
     /// Same camera at another resolution (fov semantics kept, e.g. latent res = image / 8).
     Camera with_resolution(int w, int h) const;
     /// Camera-space tangents of the half field of view in x and y.

@@ -23,19 +23,25 @@ inline uint64_t mix64(uint64_t z) {  // splitmix64 finaliser: full-avalanche 64-
     return z ^ (z >> 31);
 }
 
-/// Uniform float in [0, 1).
-inline float sample_1d(uint64_t seed, uint32_t pixel, uint32_t sample_index, uint32_t dimension) {
-    uint64_t h = mix64(seed + 0x9e3779b97f4a7c15ULL);
-    h = mix64(h ^ (uint64_t(pixel) << 32 | sample_index));
-    h = mix64(h ^ (uint64_t(dimension) * 0xd1b54a32d192ed03ULL));
-    return float(h >> 40) * 0x1.0p-24f;
+/// Hash of the (seed, pixel, sample index) key: the part shared by all dimensions of a sample.
+inline uint64_t sample_key(uint64_t seed, uint32_t pixel, uint32_t sample_index) {
+    return mix64(mix64(seed + 0x9e3779b97f4a7c15ULL) ^ (uint64_t(pixel) << 32 | sample_index));
 }
 
-/// A per-sample view: seed, pixel and sample index fixed, dimensions drawn on demand.
+inline float sample_from_key(uint64_t key, uint32_t dimension) {
+    return float(mix64(key ^ (uint64_t(dimension) * 0xd1b54a32d192ed03ULL)) >> 40) * 0x1.0p-24f;
+}
+
+/// Uniform float in [0, 1).
+inline float sample_1d(uint64_t seed, uint32_t pixel, uint32_t sample_index, uint32_t dimension) {
+    return sample_from_key(sample_key(seed, pixel, sample_index), dimension);
+}
+
+/// A per-sample view: the key is hashed once, each dimension costs one more mix.
 struct SampleStream {
-    uint64_t seed;
-    uint32_t pixel, index;
-    float get(uint32_t dimension) const { return sample_1d(seed, pixel, index, dimension); }
+    uint64_t key;
+    SampleStream(uint64_t seed, uint32_t pixel, uint32_t index) : key(sample_key(seed, pixel, index)) {}
+    float get(uint32_t dimension) const { return sample_from_key(key, dimension); }
 };
 
 }  // namespace lpt

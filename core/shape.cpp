@@ -16,6 +16,11 @@ float triangle_area(const TriangleMesh& m, size_t t) {
 void Shape::prepare() {
     size_t n = mesh.triangle_count();
     m_cdf.resize(n);
+    m_face_normals.resize(n);
+    for (size_t t = 0; t < n; ++t) {
+        const uint32_t* idx = &mesh.indices[3 * t];
+        m_face_normals[t] = (mesh.positions[idx[1]] - mesh.positions[idx[0]]).cross(mesh.positions[idx[2]] - mesh.positions[idx[0]]).normalized();
+    }
     double sum = 0.0;  // double: 270k-triangle meshes lose float precision in the running sum
     for (size_t t = 0; t < n; ++t) {
         sum += triangle_area(mesh, t);
@@ -45,8 +50,7 @@ Vec3f Shape::emission_normal(uint32_t prim, float u, float v) const {
         float len = n.norm();
         if (len > 0.f) return n / len;
     }
-    const Vec3f &p0 = mesh.positions[idx[0]], &p1 = mesh.positions[idx[1]], &p2 = mesh.positions[idx[2]];
-    return (p1 - p0).cross(p2 - p0).normalized();
+    return m_face_normals[prim];
 }
 
 SurfaceInteraction Shape::interaction(uint32_t prim, float u, float v, float t) const {
@@ -55,7 +59,7 @@ SurfaceInteraction Shape::interaction(uint32_t prim, float u, float v, float t) 
     const Vec3f &p0 = mesh.positions[idx[0]], &p1 = mesh.positions[idx[1]], &p2 = mesh.positions[idx[2]];
     float w = 1.f - u - v;
     si.p = w * p0 + u * p1 + v * p2;
-    si.ng = (p1 - p0).cross(p2 - p0).normalized();
+    si.ng = m_face_normals[prim];
     Vec3f ns = si.ng;
     if (!face_normals && !mesh.normals.empty()) {
         Vec3f n = w * mesh.normals[idx[0]] + u * mesh.normals[idx[1]] + v * mesh.normals[idx[2]];

@@ -44,6 +44,7 @@ public:
 
 private:
     std::vector<float> m_cdf;
+    std::vector<Vec3f> m_face_normals;  ///< unit, per triangle: hits and light samples reuse them
     float m_area = 0.f;
 };
 

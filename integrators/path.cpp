@@ -74,6 +74,7 @@ private:
         ws.rays[0].clear();
         ws.queue[0].clear();
         const int w = x1 - x0;
+        const Vec2f tan_half = m_camera.tan_half_fov();
         for (size_t k = 0; k < n; ++k) {
             int local = int(k) / count;
             int x = x0 + local % w, y = y0 + local / w;
@@ -81,7 +82,7 @@ private:
             p.sample[k] = uint32_t(s0 + int(k) % count);
             SampleStream rng{m_opt.seed, p.pixel[k], p.sample[k]};
             Vec2f offset = m_camera.filter.sample(Vec2f(rng.get(dim::kFilter), rng.get(dim::kFilter + 1)));
-            Ray r = m_camera.generate_ray(Vec2f(x + 0.5f + offset.x(), y + 0.5f + offset.y()));
+            Ray r = m_camera.generate_ray(Vec2f(x + 0.5f + offset.x(), y + 0.5f + offset.y()), tan_half);
             p.beta[k].setOnes();
             p.radiance[k].setZero();
             p.prev_pdf[k] = 0.f;

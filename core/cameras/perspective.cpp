@@ -19,8 +19,7 @@ Vec2f Camera::tan_half_fov() const {
     return along_x ? Vec2f(t, t / aspect) : Vec2f(t * aspect, t);
 }
 
-Ray Camera::generate_ray(const Vec2f& film_pos) const {
-    Vec2f th = tan_half_fov();
+Ray Camera::generate_ray(const Vec2f& film_pos, const Vec2f& th) const {
     float sx = film_pos.x() / float(width), sy = film_pos.y() / float(height);
     Vec3f d_cam((1.f - 2.f * sx) * th.x(), (1.f - 2.f * sy) * th.y(), 1.f);
     float inv_len = 1.f / d_cam.norm();
