@@ -71,7 +71,7 @@ Image read_image(const std::string& path) {
     img.channels = spec.nchannels;
     img.channel_names = spec.channelnames;
     img.data.resize(size_t(img.width) * img.height * img.channels);
-    if (!in->read_image(OIIO::TypeDesc::FLOAT, img.data.data()))
+    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.data.data()))
         throw std::runtime_error(path + ": cannot decode image: " + in->geterror());
     return img;
 }
