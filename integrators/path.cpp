@@ -1,6 +1,7 @@
 // The bounce loop: each stage drains one queue and fills others, so the code reads like the
-// algorithm. Stages per depth: intersect → (escaped | emitter hit) → shade (NEE + BSDF
-// sampling + Russian roulette) → trace shadow rays → swap ray queues.
+// algorithm. Stages per depth: intersect → resolve hits (escaped | emitter hit → shade queue)
+// → sample lights (NEE → shadow queue) → sample BSDFs (+ Russian roulette → next ray queue)
+// → trace shadow rays → swap ray queues. Short per-stage loops also let the CPU overlap paths.
 // Equations: docs/transport.md (1)–(4). Random dimensions: core/sampler.h.
 #include "integrators/path.h"
 #include "core/sampler.h"
@@ -30,6 +31,7 @@ template <int N>
 struct Workspace {
     RayArrays rays[2];
     ShadowQueue<N> shadow;
+    ShadeQueue shade;
     PathState<N> paths;
     std::vector<uint32_t> queue[2];
 };
@@ -53,14 +55,9 @@ public:
             ws.shadow.clear();
             ws.rays[1 - cur].clear();
             ws.queue[1 - cur].clear();
-            for (size_t i = 0; i < rays.size; ++i) {
-                uint32_t slot = ws.queue[cur][i];
-                if (!rays.hit(i)) {
-                    escaped(ws.paths, slot, rays.direction(i));
-                    continue;
-                }
-                shade(ws, cur, i, slot, depth);
-            }
+            resolve_hits(ws, cur, depth);
+            if (m_opt.strategy != LightStrategy::Bsdf && !m_scene.lights.empty()) sample_lights(ws, depth);
+            sample_bsdfs(ws, cur, depth);
             trace_shadow_rays(ws, st);
             st.extension_rays += ws.rays[1 - cur].size;
             cur = 1 - cur;
@@ -101,85 +98,112 @@ private:
         return mis_power(p.prev_pdf[slot], light_pdf);
     }
 
-    void escaped(PathState<N>& p, uint32_t slot, const Vec3f&) const {
-        int env = m_scene.environment;
-        if (env < 0) return;
-        float w = hit_weight(p, slot, m_scene.lights.pmf(env) * pdf_constant_light());
-        if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[env]);
-    }
-
-    void shade(Workspace<N>& ws, int cur, size_t i, uint32_t slot, int depth) const {
+    /// Stage 1: escaped rays and emitter hits collect emission (docs/transport.md (3)); vertices
+    /// allowed another segment go to the shade queue.
+    void resolve_hits(Workspace<N>& ws, int cur, int depth) const {
         PathState<N>& p = ws.paths;
         const RayArrays& rays = ws.rays[cur];
-        const int shape_id = int(rays.geom[i]);
-        const Shape& shape = m_scene.shapes[shape_id];
-        SurfaceInteraction si = shape.interaction(rays.prim[i], rays.u[i], rays.v[i], rays.tfar[i]);
-        const Vec3f wi_world = -rays.direction(i);
-
-        if (shape.emitter >= 0) {
-            Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
-            if (ne.dot(wi_world) > 0.f) {
-                float light_pdf = m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
-                float w = hit_weight(p, slot, light_pdf);
-                if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
+        ShadeQueue& sq = ws.shade;
+        sq.reset(rays.size);
+        const bool may_continue = m_opt.max_depth < 0 || depth + 1 < m_opt.max_depth;
+        const int env = m_scene.environment;
+        for (size_t i = 0; i < rays.size; ++i) {
+            const uint32_t slot = ws.queue[cur][i];
+            if (!rays.hit(i)) {
+                if (env < 0) continue;
+                float w = hit_weight(p, slot, m_scene.lights.pmf(env) * pdf_constant_light());
+                if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[env]);
+                continue;
             }
-        }
-        if (m_opt.max_depth >= 0 && depth + 1 >= m_opt.max_depth) return;
-
-        const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, shape_id);
-        BSDFContext ctx;
-        ctx.uv = si.uv;
-        const Vec3f wi = si.sh.to_local(wi_world);
-        SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
-
-        // Next-event estimation: docs/transport.md (2).
-        if (m_opt.strategy != LightStrategy::Bsdf && !bsdf.is_delta() && !m_scene.lights.empty()) {
-            LightSample ls = m_scene.lights.sample(m_scene.emitters, m_scene.shapes, si.p, rng.get(dim::bounce(depth, dim::kLightChoice)),
-                                                   Vec2f(rng.get(dim::bounce(depth, dim::kLightPos)), rng.get(dim::bounce(depth, dim::kLightPos + 1))));
-            if (ls.valid()) {
-                Vec3f wo = si.sh.to_local(ls.wi);
-                Spectrum<N> f = bsdf.eval(ctx, wi, wo);
-                if ((f != 0.f).any()) {
-                    bool is_env = m_scene.emitters[ls.emitter].kind == EmitterKind::Constant;
-                    float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, wi, wo));
-                    // Aim from the offset origin at the light point itself: reusing ls.wi from the
-                    // un-offset point makes the ray cross the light's plane before tmax and hit
-                    // the light (up to half the NEE energy lost under large, close lights).
-                    Vec3f o = offset_ray_origin(si.p, si.ng, ls.wi);
-                    Vec3f dir = ls.wi;
-                    float tmax = kInf;
-                    if (!is_env) {
-                        Vec3f d = ls.p - o;
-                        float dist = d.norm();
-                        dir = d / dist;
-                        tmax = dist * (1.f - 1e-4f);
-                    }
-                    ws.shadow.rays.push(o, dir, 0.f, tmax);
-                    ws.shadow.slot.push_back(slot);
-                    ws.shadow.contribution.push_back(p.beta[slot] * f * m_spectra.radiance[ls.emitter] * (w / ls.pdf));
+            const int shape_id = int(rays.geom[i]);
+            const Shape& shape = m_scene.shapes[shape_id];
+            SurfaceInteraction si = shape.interaction(rays.prim[i], rays.u[i], rays.v[i], rays.tfar[i]);
+            const Vec3f wi_world = -rays.direction(i);
+            if (shape.emitter >= 0) {
+                Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
+                if (ne.dot(wi_world) > 0.f) {
+                    float light_pdf = m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
+                    float w = hit_weight(p, slot, light_pdf);
+                    if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
                 }
             }
+            if (!may_continue) continue;
+            const size_t k = sq.count++;
+            sq.slot[k] = slot;
+            sq.shape[k] = shape_id;
+            sq.p[k] = si.p;
+            sq.ng[k] = si.ng;
+            sq.wi[k] = si.sh.to_local(wi_world);
+            sq.frame[k] = si.sh;
+            sq.uv[k] = si.uv;
         }
+    }
 
-        // BSDF sampling: docs/transport.md (1).
-        BSDFSample<N> bs = bsdf.sample(ctx, wi, rng.get(dim::bounce(depth, dim::kBsdfLobe)),
-                                       Vec2f(rng.get(dim::bounce(depth, dim::kBsdfDir)), rng.get(dim::bounce(depth, dim::kBsdfDir + 1))));
-        if (!bs.valid()) return;
-        Spectrum<N> beta = p.beta[slot] * bs.weight;
-        // Russian roulette on |throughput|: sign-safe for latent spectra.
-        if (depth + 1 >= m_opt.rr_depth) {
-            float q = std::min(beta.abs().maxCoeff(), 0.95f);
-            if (rng.get(dim::bounce(depth, dim::kRR)) >= q) return;
-            beta /= q;
+    /// Stage 2: next-event estimation (docs/transport.md (2)) for every non-delta vertex.
+    void sample_lights(Workspace<N>& ws, int depth) const {
+        PathState<N>& p = ws.paths;
+        const ShadeQueue& sq = ws.shade;
+        for (size_t k = 0; k < sq.size(); ++k) {
+            const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
+            if (bsdf.is_delta()) continue;
+            const uint32_t slot = sq.slot[k];
+            SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
+            LightSample ls = m_scene.lights.sample(m_scene.emitters, m_scene.shapes, sq.p[k], rng.get(dim::bounce(depth, dim::kLightChoice)),
+                                                   Vec2f(rng.get(dim::bounce(depth, dim::kLightPos)), rng.get(dim::bounce(depth, dim::kLightPos + 1))));
+            if (!ls.valid()) continue;
+            BSDFContext ctx;
+            ctx.uv = sq.uv[k];
+            const Vec3f wo = sq.frame[k].to_local(ls.wi);
+            Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
+            if (!(f != 0.f).any()) continue;
+            float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
+            // Aim from the offset origin at the light point itself: reusing ls.wi from the
+            // un-offset point makes the ray cross the light's plane before tmax and hit the light
+            // (up to half the NEE energy lost under large, close lights).
+            Vec3f o = offset_ray_origin(sq.p[k], sq.ng[k], ls.wi);
+            Vec3f dir = ls.wi;
+            float tmax = kInf;
+            if (m_scene.emitters[ls.emitter].kind != EmitterKind::Constant) {
+                Vec3f d = ls.p - o;
+                float dist = d.norm();
+                dir = d / dist;
+                tmax = dist * (1.f - 1e-4f);
+            }
+            ws.shadow.rays.push(o, dir, 0.f, tmax);
+            ws.shadow.slot.push_back(slot);
+            ws.shadow.contribution.push_back(p.beta[slot] * f * m_spectra.radiance[ls.emitter] * (w / ls.pdf));
         }
-        if (!(beta != 0.f).any()) return;
-        const Vec3f wo_world = si.sh.to_world(bs.wo);
-        p.beta[slot] = beta;
-        p.prev_pdf[slot] = bs.pdf;
-        p.prev_delta[slot] = (bs.lobe & kDelta) != 0;
-        p.prev_p[slot] = si.p;
-        ws.rays[1 - cur].push(offset_ray_origin(si.p, si.ng, wo_world), wo_world, 0.f, kInf);
-        ws.queue[1 - cur].push_back(slot);
+    }
+
+    /// Stage 3: BSDF sampling (docs/transport.md (1)) and Russian roulette (4) → next rays.
+    void sample_bsdfs(Workspace<N>& ws, int cur, int depth) const {
+        PathState<N>& p = ws.paths;
+        const ShadeQueue& sq = ws.shade;
+        for (size_t k = 0; k < sq.size(); ++k) {
+            const uint32_t slot = sq.slot[k];
+            const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
+            SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
+            BSDFContext ctx;
+            ctx.uv = sq.uv[k];
+            BSDFSample<N> bs = bsdf.sample(ctx, sq.wi[k], rng.get(dim::bounce(depth, dim::kBsdfLobe)),
+                                           Vec2f(rng.get(dim::bounce(depth, dim::kBsdfDir)), rng.get(dim::bounce(depth, dim::kBsdfDir + 1))));
+            if (!bs.valid()) continue;
+            Spectrum<N> beta = p.beta[slot] * bs.weight;
+            // |throughput|: sign-safe for latent spectra.
+            if (depth + 1 >= m_opt.rr_depth) {
+                float q = std::min(beta.abs().maxCoeff(), 0.95f);
+                if (rng.get(dim::bounce(depth, dim::kRR)) >= q) continue;
+                beta /= q;
+            }
+            if (!(beta != 0.f).any()) continue;
+            const Vec3f wo_world = sq.frame[k].to_world(bs.wo);
+            p.beta[slot] = beta;
+            p.prev_pdf[slot] = bs.pdf;
+            p.prev_delta[slot] = (bs.lobe & kDelta) != 0;
+            p.prev_p[slot] = sq.p[k];
+            ws.rays[1 - cur].push(offset_ray_origin(sq.p[k], sq.ng[k], wo_world), wo_world, 0.f, kInf);
+            ws.queue[1 - cur].push_back(slot);
+        }
     }
 
     void trace_shadow_rays(Workspace<N>& ws, RenderStats& st) const {

@@ -52,6 +52,24 @@ struct PathState {
     }
 };
 
+/// Surface vertices waiting to be shaded (NEE, then BSDF sampling), in queue order. Arrays keep
+/// their capacity across depths; `count` entries are live.
+struct ShadeQueue {
+    std::vector<uint32_t> slot;
+    std::vector<int> shape;
+    AlignedVector<Vec3f> p, ng, wi;  ///< wi in the local shading frame
+    std::vector<Frame> frame;
+    AlignedVector<Vec2f> uv;
+    size_t count = 0;
+    void reset(size_t capacity) {
+        count = 0;
+        if (slot.size() >= capacity) return;
+        slot.resize(capacity); shape.resize(capacity); p.resize(capacity); ng.resize(capacity);
+        wi.resize(capacity); frame.resize(capacity); uv.resize(capacity);
+    }
+    size_t size() const { return count; }
+};
+
 /// Shadow rays of next-event estimation with the contribution each delivers if unblocked.
 template <int N>
 struct ShadowQueue {
