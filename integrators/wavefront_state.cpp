@@ -3,8 +3,15 @@
 namespace lpt {
 
 void RayArrays::reserve(size_t n) {
-    for (auto* a : {&ox, &oy, &oz, &tnear, &dx, &dy, &dz, &time, &tfar, &ngx, &ngy, &ngz, &u, &v}) a->resize(n);
-    for (auto* a : {&mask, &id, &flags, &prim, &geom, &inst}) a->resize(n);
+    size_t old = ox.size();
+    for (auto* a : {&ox, &oy, &oz, &tnear, &dx, &dy, &dz, &tfar, &ngx, &ngy, &ngz, &u, &v}) a->resize(n);
+    for (auto* a : {&prim, &geom, &inst}) a->resize(n);
+    // Fields no stage changes are written once here instead of per ray.
+    time.resize(n, 0.f);
+    mask.resize(n, ~0u);
+    flags.resize(n, 0u);
+    id.resize(n);
+    for (size_t i = old; i < n; ++i) id[i] = unsigned(i);
 }
 
 size_t RayArrays::push(const Vec3f& o, const Vec3f& d, float tmin, float tmax) {
@@ -12,9 +19,8 @@ size_t RayArrays::push(const Vec3f& o, const Vec3f& d, float tmin, float tmax) {
     size_t i = size++;
     ox[i] = o.x(); oy[i] = o.y(); oz[i] = o.z();
     dx[i] = d.x(); dy[i] = d.y(); dz[i] = d.z();
-    tnear[i] = tmin; tfar[i] = tmax; time[i] = 0.f;
-    mask[i] = ~0u; id[i] = unsigned(i); flags[i] = 0;
-    geom[i] = RTC_INVALID_GEOMETRY_ID; inst[i] = RTC_INVALID_GEOMETRY_ID;
+    tnear[i] = tmin; tfar[i] = tmax;
+    geom[i] = RTC_INVALID_GEOMETRY_ID;  // Embree leaves it untouched on a miss
     return i;
 }
 
