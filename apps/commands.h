@@ -16,6 +16,7 @@ struct RenderArgs {
     int max_depth = -2;           ///< -2 = the scene's
     std::string strategy = "mis";
     bool aov = false;
+    std::string aov_res;          ///< "WxH", empty = the image's
     float exposure = 0.f;
     std::map<std::string, std::string> defines;
     bool quiet = false;

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     render->add_option("--strategy", r.strategy, "light estimator: mis (NEE + BSDF sampling), nee, bsdf")
         ->check(CLI::IsMember({"mis", "nee", "bsdf"}))->capture_default_str();
     render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr");
+    render->add_option("--aov-res", r.aov_res, "AOV resolution WxH (default: the image's; e.g. image/8 for latents)");
     render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")->capture_default_str();
     render->add_option("-D,--define", defines, "override a scene value, e.g. -D integrator.max_depth=4");
     render->add_flag("-q,--quiet", r.quiet, "no progress line");

@@ -40,7 +40,9 @@ int run_render(const RenderArgs& a) {
     write_exr(a.out, img);
     write_png_srgb(with_suffix(a.out, ".png"), img, a.exposure);
     if (a.aov) {
-        AovImages aov = render_aovs(scene, spectra, img.width, img.height, std::min(opt.spp, 16), a.seed);
+        int aw = img.width, ah = img.height;
+        if (!a.aov_res.empty()) parse_resolution(a.aov_res, aw, ah);
+        AovImages aov = render_aovs(scene, spectra, aw, ah, std::min(opt.spp, 16), a.seed);
         write_exr(with_suffix(a.out, ".normal.exr"), Image{aov.width, aov.height, 3, aov.normal, {"X", "Y", "Z"}});
         write_exr(with_suffix(a.out, ".distance.exr"), Image{aov.width, aov.height, 1, aov.distance, {"Z"}});
         write_exr(with_suffix(a.out, ".albedo.exr"), Image{aov.width, aov.height, 3, aov.albedo, {"R", "G", "B"}});

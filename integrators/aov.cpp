@@ -24,7 +24,9 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
                 Ray r = camera.generate_ray(Vec2f(x + 0.5f + off.x(), y + 0.5f + off.y()));
                 SurfaceInteraction si = scene.intersect(r);
                 if (!si.valid()) continue;
-                n_sum += si.sh.n;
+                // Face the viewer: two-sided surfaces' stored winding is arbitrary, and the refiner
+                // should see the side the camera sees.
+                n_sum += si.sh.n.dot(r.d) > 0.f ? Vec3f(-si.sh.n) : si.sh.n;
                 d_sum += si.t;
                 BSDFContext ctx;
                 ctx.uv = si.uv;

@@ -1,5 +1,5 @@
 // Arbitrary output variables of the first camera hit, at any resolution (the refiner wants them
-// at latent resolution): world shading normal, distance along the camera ray (0 on a miss) and
+// at latent resolution): world shading normal (facing the camera), distance along the camera ray (0 on a miss) and
 // albedo. Averaged over `spp` filter samples per pixel with the renderer's random numbers.
 #pragma once
 #include "core/scene.h"
@@ -10,7 +10,7 @@ namespace lpt {
 
 struct AovImages {
     int width = 0, height = 0;
-    std::vector<float> normal;    ///< 3 per pixel, world space, averaged (not renormalised)
+    std::vector<float> normal;    ///< 3 per pixel, world space, turned toward the camera, averaged (not renormalised)
     std::vector<float> distance;  ///< 1 per pixel
     std::vector<float> albedo;    ///< 3 per pixel
 };
