@@ -33,6 +33,10 @@ void LightSampler::build(const std::vector<Emitter>& emitters, const std::vector
 }
 
 int LightSampler::choose(float u, float* u_reuse) const {
+    if (m_pmf.size() == 1) {  // the common single-light scene: no search
+        if (u_reuse) *u_reuse = u;
+        return 0;
+    }
     int i = int(std::upper_bound(m_cdf.begin(), m_cdf.end(), u) - m_cdf.begin());
     i = std::min(i, int(m_cdf.size()) - 1);
     while (m_pmf[i] == 0.f && i > 0) --i;  // never return a zero-probability light

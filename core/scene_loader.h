@@ -11,5 +11,8 @@ namespace lpt {
 /// for JSON: "integrator.spp", "camera.width", ... see docs/scene-format.md).
 Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines = {});
 Scene load_scene_json(const std::string& path, const std::map<std::string, std::string>& defines = {});
+/// Mitsuba 3 XML (docs/scene-format.md, "Mitsuba 3 XML"); `defines` override <default> values like
+/// Mitsuba's -D name=value.
+Scene load_scene_mitsuba_xml(const std::string& path, const std::map<std::string, std::string>& defines = {});
 
 }  // namespace lpt

@@ -12,9 +12,11 @@ namespace lpt {
 template <int N>
 struct SceneSpectra {
     std::vector<std::unique_ptr<BSDF<N>>> bsdfs;  ///< per Scene::materials entry
+    std::vector<uint8_t> only_delta;              ///< per material: BSDF::is_delta(), cached (hot in NEE)
     std::vector<Spectrum<N>, Eigen::aligned_allocator<Spectrum<N>>> radiance;  ///< per Scene::emitters entry
 
     const BSDF<N>& bsdf_of(const Scene& scene, int shape) const { return *bsdfs[scene.shapes[shape].material]; }
+    bool is_delta(const Scene& scene, int shape) const { return only_delta[scene.shapes[shape].material] != 0; }
     /// From the scene's RGB descriptions (spectrum_from_rgb<N>).
     static SceneSpectra from_description(const Scene& scene);
 };

@@ -144,8 +144,8 @@ private:
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
         for (size_t k = 0; k < sq.size(); ++k) {
+            if (m_spectra.is_delta(m_scene, sq.shape[k])) continue;
             const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
-            if (bsdf.is_delta()) continue;
             const uint32_t slot = sq.slot[k];
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
             LightSample ls = m_scene.lights.sample(m_scene.emitters, m_scene.shapes, sq.p[k], rng.get(dim::bounce(depth, dim::kLightChoice)),

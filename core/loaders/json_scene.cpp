@@ -317,7 +317,8 @@ Scene load_scene(const std::string& path, const std::map<std::string, std::strin
     std::string ext = fs::path(path).extension().string();
     for (auto& ch : ext) ch = char(std::tolower(ch));
     if (ext == ".json") return load_scene_json(path, defines);
-    throw SceneError(path, "", "unknown scene format '" + ext + "' (known: .json)");
+    if (ext == ".xml") return load_scene_mitsuba_xml(path, defines);
+    throw SceneError(path, "", "unknown scene format '" + ext + "' (known: .json, .xml)");
 }
 
 }  // namespace lpt
