@@ -1,0 +1,97 @@
+// ParamStore: maps, their derivatives (central differences), clamps and JSON round trip.
+#include "core/param_store.h"
+#include <gtest/gtest.h>
+#include <cmath>
+
+using namespace lpt;
+
+namespace {
+ParamStore make_store() {
+    ParamStore ps;
+    ps.add("a.La", "La", ParamMap::Identity, 4, -6.f, 6.f);
+    ps.add("a.bsdf.reflectance", "reflectance", ParamMap::Sigmoid, 4, -1e9f, 1e9f);
+    ps.add("a.Lc", "Lc", ParamMap::PosNeg, 4, 0.f, 1.f);
+    ps.init_uniform("La", -1.f, 1.f, 1);
+    ps.init_uniform("reflectance", -2.f, 2.f, 2);
+    ps.init_uniform("Lc", 0.f, 1.f, 3);
+    return ps;
+}
+}  // namespace
+
+TEST(ParamStore, BackwardMatchesFiniteDifferencesOfEveryMap) {
+    ParamStore ps = make_store();
+    // Loss = sum_c w_c * value_c with fixed weights: d loss / d value = w.
+    std::vector<float> w(ps.values().size());
+    for (size_t i = 0; i < w.size(); ++i) w[i] = 0.3f + 0.1f * float(i);
+    auto loss = [&](ParamStore& p) {
+        p.update_values();
+        double l = 0;
+        for (size_t i = 0; i < w.size(); ++i) l += double(w[i]) * p.values()[i];
+        return l;
+    };
+    ps.zero_grad();
+    ps.grad_values() = w;
+    ps.backward();
+    const float h = 1e-3f;
+    for (size_t k = 0; k < ps.raw().size(); ++k) {
+        ParamStore p = ps;
+        p.raw()[k] += h;
+        double lp = loss(p);
+        p.raw()[k] -= 2 * h;
+        double lm = loss(p);
+        double fd = (lp - lm) / (2 * h);
+        EXPECT_NEAR(ps.grad_raw()[k], fd, 1e-3 * std::max(1.0, std::abs(fd))) << "raw index " << k;
+    }
+}
+
+TEST(ParamStore, SetValueRoundTripsThroughEveryMap) {
+    ParamStore ps = make_store();
+    const float v[4] = {-0.5f, 0.f, 0.25f, 0.9f};
+    for (int s : {0, 2}) {
+        ps.set_value(s, v);
+        for (int c = 0; c < 4; ++c) EXPECT_NEAR(ps.value(s)[c], v[c], 1e-6f);
+    }
+    const float r[4] = {0.1f, 0.5f, 0.75f, 0.99f};
+    ps.set_value(1, r);
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(ps.value(1)[c], r[c], 1e-5f);
+    const float bad[4] = {1.5f, 0.f, 0.f, 0.f};
+    EXPECT_THROW(ps.set_value(1, bad), std::invalid_argument);  // sigmoid cannot reach 1.5
+    EXPECT_THROW(ps.set_value(2, bad), std::invalid_argument);  // PosNeg parts limited to [0, 1]
+}
+
+TEST(ParamStore, ClampKeepsRawInRange) {
+    ParamStore ps = make_store();
+    for (float& r : ps.raw()) r = 100.f;
+    ps.clamp_raw();
+    EXPECT_FLOAT_EQ(ps.value(0)[0], 6.f);
+    EXPECT_FLOAT_EQ(ps.value(2)[0], 0.f);  // pos = neg = 1 after the clamp
+    EXPECT_GT(ps.raw()[ps.slice(1).raw_offset], 99.f);  // sigmoid raw is unbounded
+}
+
+TEST(ParamStore, JsonRoundTripIsExact) {
+    ParamStore a = make_store();
+    ParamStore b = make_store();
+    for (float& r : b.raw()) r = 0.f;
+    b.load_json(a.to_json(), "params.json");
+    b.update_values();
+    EXPECT_EQ(a.raw(), b.raw());
+    EXPECT_EQ(a.values(), b.values());
+}
+
+TEST(ParamStore, JsonErrorsNameFileAndParameter) {
+    ParamStore ps = make_store();
+    auto expect_error = [&](const std::string& json, const std::string& needle) {
+        try {
+            ps.load_json(json, "fit/params.json");
+            FAIL() << "expected an error for " << json;
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find("fit/params.json"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+        }
+    };
+    expect_error(R"({"slices": [{"name": "ghost.La", "raw": [0,0,0,0]}]})", "ghost.La");
+    expect_error(R"({"slices": [{"name": "a.La", "raw": [0,0]}]})", "a.La");
+    expect_error(R"({"slices": [{"name": "a.La", "map": "sigmoid", "raw": [0,0,0,0]}]})", "sigmoid");
+    expect_error(R"({"slices": [)", "malformed");
+    EXPECT_THROW(ps.add("a.La", "La", ParamMap::Identity, 4, -6.f, 6.f), std::invalid_argument);
+}
