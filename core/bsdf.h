@@ -9,6 +9,9 @@
 #include "core/spectrum.h"
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace lpt {
 
@@ -59,6 +62,14 @@ public:
     virtual uint32_t flags() const = 0;
     /// Hemispherical reflectance-like colour for the albedo AOV (not an integral; a display value).
     virtual Spectrum<N> albedo(const BSDFContext& ctx) const = 0;
+
+    /// Spectral coefficients exposed to fitting, by scene-file key (e.g. "reflectance"); the
+    /// latent renderer fills them from its ParamStore (docs/params.md).
+    virtual std::vector<std::string> spectral_keys() const { return {}; }
+    /// Replaces one of spectral_keys(); throws std::invalid_argument for any other key.
+    virtual void set_spectral(const std::string& key, const Spectrum<N>& value) {
+        throw std::invalid_argument("BSDF has no spectral coefficient '" + key + "'");
+    }
 
     bool has_delta() const { return (flags() & kDelta) != 0; }
     bool is_delta() const { return (flags() & kNonDelta) == 0; }

@@ -35,6 +35,12 @@ public:
     uint32_t flags() const override { return kDeltaReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_specular * m_ior.fresnel(1.f); }
 
+    std::vector<std::string> spectral_keys() const override { return {"specular_reflectance"}; }
+    void set_spectral(const std::string& key, const Spectrum<N>& v) override {
+        if (key != "specular_reflectance") BSDF<N>::set_spectral(key, v);
+        m_specular = v;
+    }
+
 private:
     Spectrum<N> m_specular;
     ConductorIOR<N> m_ior;

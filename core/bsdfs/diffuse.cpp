@@ -38,6 +38,12 @@ public:
     uint32_t flags() const override { return kDiffuseReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_reflectance; }
 
+    std::vector<std::string> spectral_keys() const override { return {"reflectance"}; }
+    void set_spectral(const std::string& key, const Spectrum<N>& v) override {
+        if (key != "reflectance") BSDF<N>::set_spectral(key, v);
+        m_reflectance = v;
+    }
+
 private:
     Spectrum<N> m_reflectance;
 };

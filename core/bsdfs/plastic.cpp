@@ -29,8 +29,14 @@ public:
         m_inv_eta2 = 1.f / (m_eta * m_eta);
         m_fdr_int = fresnel_diffuse_reflectance(1.f / m_eta);
         // docs/bsdfs.md (23): the base colour after internal bounces, an infinite geometric series.
-        m_base = m_nonlinear ? Spectrum<N>(m_diffuse / (1.f - m_diffuse * m_fdr_int))
-                             : Spectrum<N>(m_diffuse / (1.f - m_fdr_int));
+        update_base();
+    }
+
+    std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
+    void set_spectral(const std::string& key, const Spectrum<N>& v) override {
+        if (key == "diffuse_reflectance") m_diffuse = v, update_base();
+        else if (key == "specular_reflectance") m_specular = v;
+        else BSDF<N>::set_spectral(key, v);
     }
 
     Spectrum<N> eval(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -72,6 +78,11 @@ public:
     Spectrum<N> albedo(const BSDFContext&) const override { return m_diffuse; }
 
 private:
+    void update_base() {
+        m_base = m_nonlinear ? Spectrum<N>(m_diffuse / (1.f - m_diffuse * m_fdr_int))
+                             : Spectrum<N>(m_diffuse / (1.f - m_fdr_int));
+    }
+
     float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f;
     Spectrum<N> m_diffuse, m_specular, m_base;
     bool m_nonlinear;

@@ -93,6 +93,13 @@ public:
     uint32_t flags() const override { return kGlossyReflection | kGlossyTransmission; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_transmittance; }
 
+    std::vector<std::string> spectral_keys() const override { return {"specular_reflectance", "specular_transmittance"}; }
+    void set_spectral(const std::string& key, const Spectrum<N>& v) override {
+        if (key == "specular_reflectance") m_reflectance = v;
+        else if (key == "specular_transmittance") m_transmittance = v;
+        else BSDF<N>::set_spectral(key, v);
+    }
+
 private:
     struct Half {
         Vec3f m = Vec3f::UnitZ();

@@ -34,11 +34,17 @@ public:
           m_diffuse(spectrum_from_rgb<N>(props.get_rgb("diffuse_reflectance", Eigen::Array3f::Constant(0.5f)))),
           m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))) {
         m_inv_eta2 = 1.f / (m_eta * m_eta);
-        bool nonlinear = props.get_bool("nonlinear", false);
+        m_nonlinear = props.get_bool("nonlinear", false);
         float mean_t = build_table();
-        float fdr_int = 1.f - mean_t * m_inv_eta2;  // docs/bsdfs.md (27)
-        m_base = nonlinear ? Spectrum<N>(m_diffuse / (1.f - m_diffuse * fdr_int))
-                           : Spectrum<N>(m_diffuse / (1.f - fdr_int));
+        m_fdr_int = 1.f - mean_t * m_inv_eta2;  // docs/bsdfs.md (27)
+        update_base();
+    }
+
+    std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
+    void set_spectral(const std::string& key, const Spectrum<N>& v) override {
+        if (key == "diffuse_reflectance") m_diffuse = v, update_base();
+        else if (key == "specular_reflectance") m_specular = v;
+        else BSDF<N>::set_spectral(key, v);
     }
 
     Spectrum<N> eval(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -89,6 +95,11 @@ public:
     Spectrum<N> albedo(const BSDFContext&) const override { return m_diffuse; }
 
 private:
+    void update_base() {
+        m_base = m_nonlinear ? Spectrum<N>(m_diffuse / (1.f - m_diffuse * m_fdr_int))
+                             : Spectrum<N>(m_diffuse / (1.f - m_fdr_int));
+    }
+
     // t(mu) by linear interpolation over mu = j / (kTableRes - 1), as Mitsuba's lerp_gather.
     float transmittance(float mu) const {
         float x = std::clamp(mu, 0.f, 1.f) * (kTableRes - 1);
@@ -127,7 +138,8 @@ private:
     }
 
     MicrofacetDistribution m_distr;
-    float m_eta, m_inv_eta2 = 1.f;
+    float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f;
+    bool m_nonlinear = false;
     Spectrum<N> m_diffuse, m_specular, m_base;
     std::array<float, kTableRes> m_table{};
 };

@@ -41,6 +41,9 @@ public:
     uint32_t flags() const override { return m_nested->flags(); }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_nested->albedo(ctx); }
 
+    std::vector<std::string> spectral_keys() const override { return m_nested->spectral_keys(); }
+    void set_spectral(const std::string& key, const Spectrum<N>& v) override { m_nested->set_spectral(key, v); }
+
 private:
     std::unique_ptr<BSDF<N>> m_nested;
 };
