@@ -39,11 +39,14 @@ struct Workspace {
 template <int N>
 class PathTracer {
 public:
-    PathTracer(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, const Camera& camera)
-        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera) {}
+    PathTracer(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, const Camera& camera,
+               const LatentTerms<N>* terms)
+        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_terms(terms),
+          m_emission(!terms || terms->emission) {}
 
     /// Traces samples [s0, s0 + count) of every pixel in [x0,x1)×[y0,y1) and adds them to film.
-    void trace_tile(Workspace<N>& ws, Film<N>& film, int x0, int y0, int x1, int y1, int s0, int count, RenderStats& st) const {
+    /// films[1], films[2] (Ĩa, Ĩc) are written only for latent terms.
+    void trace_tile(Workspace<N>& ws, Film<N>* const films[3], int x0, int y0, int x1, int y1, int s0, int count, RenderStats& st) const {
         const int tile_pixels = (x1 - x0) * (y1 - y0);
         const size_t n = size_t(tile_pixels) * count;
         ws.paths.resize(n);
@@ -62,7 +65,13 @@ public:
             st.extension_rays += ws.rays[1 - cur].size;
             cur = 1 - cur;
         }
-        for (size_t k = 0; k < n; ++k) film.add_sample(int(ws.paths.pixel[k]), ws.paths.radiance[k]);
+        for (size_t k = 0; k < n; ++k) {
+            films[0]->add_sample(int(ws.paths.pixel[k]), ws.paths.radiance[k]);
+            if (m_terms) {
+                films[1]->add_sample(int(ws.paths.pixel[k]), ws.paths.ambient[k]);
+                films[2]->add_sample(int(ws.paths.pixel[k]), ws.paths.occlusion[k]);
+            }
+        }
     }
 
 private:
@@ -82,6 +91,9 @@ private:
             Ray r = m_camera.generate_ray(Vec2f(x + 0.5f + offset.x(), y + 0.5f + offset.y()), tan_half);
             p.beta[k].setOnes();
             p.radiance[k].setZero();
+            p.ambient[k].setZero();
+            p.occlusion[k].setZero();
+            p.past_first[k] = 0;
             p.prev_pdf[k] = 0.f;
             p.prev_delta[k] = 1;  // a camera ray sees emitters with full weight, like a delta bounce
             p.prev_p[k] = r.o;
@@ -110,7 +122,8 @@ private:
         for (size_t i = 0; i < rays.size; ++i) {
             const uint32_t slot = ws.queue[cur][i];
             if (!rays.hit(i)) {
-                if (env < 0) continue;
+                if (m_terms && m_terms->ambient && !p.past_first[slot]) p.ambient[slot] += p.beta[slot] * m_terms->background;
+                if (env < 0 || !m_emission) continue;
                 float w = hit_weight(p, slot, m_scene.lights.pmf(env) * pdf_constant_light());
                 if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[env]);
                 continue;
@@ -119,7 +132,7 @@ private:
             const Shape& shape = m_scene.shapes[shape_id];
             SurfaceInteraction si = shape.interaction(rays.prim[i], rays.u[i], rays.v[i], rays.tfar[i]);
             const Vec3f wi_world = -rays.direction(i);
-            if (shape.emitter >= 0) {
+            if (shape.emitter >= 0 && m_emission) {
                 Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
                 if (ne.dot(wi_world) > 0.f) {
                     float light_pdf = m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
@@ -127,8 +140,19 @@ private:
                     if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
                 }
             }
-            if (!may_continue) continue;
+            // Latent: Ĩa at the first non-delta vertex of E S* D, and flag it for Ĩc's gate.
+            bool first = false;
+            if (m_terms && !p.past_first[slot] && !m_spectra.is_delta(m_scene, shape_id)) {
+                first = true;
+                p.past_first[slot] = 1;
+                if (m_terms->ambient) p.ambient[slot] += p.beta[slot] * m_terms->La[shape_id];
+            }
+            // Without Ĩe nothing is collected after the first non-delta vertex.
+            const bool cont = may_continue && (m_emission || !p.past_first[slot]);
+            const uint8_t flags = (cont ? ShadeQueue::kContinue : 0) | (first && m_terms->occlusion ? ShadeQueue::kFirst : 0);
+            if (!flags) continue;
             const size_t k = sq.count++;
+            sq.flags[k] = flags;
             sq.slot[k] = slot;
             sq.shape[k] = shape_id;
             sq.p[k] = si.p;
@@ -139,24 +163,48 @@ private:
         }
     }
 
-    /// Stage 2: next-event estimation (docs/transport.md (2)) for every non-delta vertex.
+    /// Stage 2: next-event estimation (docs/transport.md (2)) for every non-delta vertex; at the
+    /// latent first vertex the same light sample gates Ĩc (docs/transport.md (6)).
     void sample_lights(Workspace<N>& ws, int depth) const {
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
+        const bool nee_on = m_emission && m_opt.strategy != LightStrategy::Bsdf && !m_scene.lights.empty();
         for (size_t k = 0; k < sq.size(); ++k) {
-            if (m_spectra.is_delta(m_scene, sq.shape[k])) continue;
-            const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
+            const bool first = (sq.flags[k] & ShadeQueue::kFirst) != 0;
+            const bool nee = nee_on && (sq.flags[k] & ShadeQueue::kContinue) && !m_spectra.is_delta(m_scene, sq.shape[k]);
+            if (!nee && !first) continue;
             const uint32_t slot = sq.slot[k];
+            Spectrum<N> occl = Spectrum<N>::Zero();
+            if (first) occl = p.beta[slot] * m_terms->Lc[sq.shape[k]];
+            const bool gate_shadowed = m_terms && m_terms->gate == OcclusionGate::Shadowed;
+            if (m_scene.lights.empty()) {  // no light: everything is in shadow
+                if (first && gate_shadowed) p.occlusion[slot] += occl;
+                continue;
+            }
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
             LightSample ls = m_scene.lights.sample(m_scene.emitters, m_scene.shapes, sq.p[k], rng.get(dim::bounce(depth, dim::kLightChoice)),
                                                    Vec2f(rng.get(dim::bounce(depth, dim::kLightPos)), rng.get(dim::bounce(depth, dim::kLightPos + 1))));
-            if (!ls.valid()) continue;
-            BSDFContext ctx;
-            ctx.uv = sq.uv[k];
-            const Vec3f wo = sq.frame[k].to_local(ls.wi);
-            Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
-            if (!(f != 0.f).any()) continue;
-            float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
+            // A light sample behind the light or below the viewer's side of the surface is an
+            // attached shadow: V = 0 without tracing.
+            const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
+            if (!ls.valid() || sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f) {
+                if (first && gate_shadowed) p.occlusion[slot] += occl;
+                continue;
+            }
+            Spectrum<N> contribution = Spectrum<N>::Zero();
+            if (nee) {
+                const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
+                BSDFContext ctx;
+                ctx.uv = sq.uv[k];
+                const Vec3f wo = sq.frame[k].to_local(ls.wi);
+                Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
+                if ((f != 0.f).any()) {
+                    float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
+                    contribution = p.beta[slot] * f * m_spectra.radiance[ls.emitter] * (w / ls.pdf);
+                } else if (!first) {
+                    continue;
+                }
+            }
             // Aim from the offset origin at the light point itself: reusing ls.wi from the
             // un-offset point makes the ray cross the light's plane before tmax and hit the light
             // (up to half the NEE energy lost under large, close lights).
@@ -171,7 +219,8 @@ private:
             }
             ws.shadow.rays.push(o, dir, 0.f, tmax);
             ws.shadow.slot.push_back(slot);
-            ws.shadow.contribution.push_back(p.beta[slot] * f * m_spectra.radiance[ls.emitter] * (w / ls.pdf));
+            ws.shadow.contribution.push_back(contribution);
+            if (m_terms) ws.shadow.occlusion.push_back(occl);
         }
     }
 
@@ -180,6 +229,7 @@ private:
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
         for (size_t k = 0; k < sq.size(); ++k) {
+            if (!(sq.flags[k] & ShadeQueue::kContinue)) continue;
             const uint32_t slot = sq.slot[k];
             const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
@@ -210,24 +260,26 @@ private:
         ShadowQueue<N>& sq = ws.shadow;
         sq.rays.occluded(m_scene.rtc());
         st.shadow_rays += sq.rays.size;
-        for (size_t j = 0; j < sq.rays.size; ++j)
-            if (!sq.rays.blocked(j)) ws.paths.radiance[sq.slot[j]] += sq.contribution[j];
+        for (size_t j = 0; j < sq.rays.size; ++j) {
+            const bool blocked = sq.rays.blocked(j);
+            if (!blocked) ws.paths.radiance[sq.slot[j]] += sq.contribution[j];
+            if (m_terms && blocked == (m_terms->gate == OcclusionGate::Shadowed)) ws.paths.occlusion[sq.slot[j]] += sq.occlusion[j];
+        }
     }
 
     const Scene& m_scene;
     const SceneSpectra<N>& m_spectra;
     const RenderOptions& m_opt;
     const Camera& m_camera;
+    const LatentTerms<N>* m_terms;  ///< null for plain (RGB) rendering
+    const bool m_emission;          ///< Ĩe on
 };
 
-}  // namespace
-
+/// Shared driver: tiles in parallel, each tile's pixels owned by one task (deterministic).
 template <int N>
-Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, RenderStats* stats) {
+void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>* terms, const RenderOptions& opt,
+                  const Camera& camera, Film<N>* const films[3], RenderStats* stats) {
     auto t0 = std::chrono::steady_clock::now();
-    Camera camera = scene.camera.with_resolution(opt.width > 0 ? opt.width : scene.camera.width,
-                                                 opt.height > 0 ? opt.height : scene.camera.height);
-    Film<N> film(camera.width, camera.height);
     const int tiles_x = (camera.width + kTile - 1) / kTile, tiles_y = (camera.height + kTile - 1) / kTile;
     const int n_tiles = tiles_x * tiles_y;
     tbb::enumerable_thread_specific<Workspace<N>> workspaces;
@@ -235,6 +287,7 @@ Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const Re
     std::atomic<uint64_t> rays_done{0};
     std::mutex stats_mutex;
     RenderStats total;
+    const PathTracer<N> tracer(scene, spectra, opt, camera, terms);
 
     tbb::parallel_for(0, n_tiles, [&](int t) {
         set_ftz_daz();
@@ -243,10 +296,7 @@ Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const Re
         int x1 = std::min(x0 + kTile, camera.width), y1 = std::min(y0 + kTile, camera.height);
         int per_chunk = std::max(1, int(kWavefront / size_t((x1 - x0) * (y1 - y0))));
         RenderStats st;
-        for (int s0 = 0; s0 < opt.spp; s0 += per_chunk) {
-            PathTracer<N> tracer(scene, spectra, opt, camera);
-            tracer.trace_tile(ws, film, x0, y0, x1, y1, s0, std::min(per_chunk, opt.spp - s0), st);
-        }
+        for (int s0 = 0; s0 < opt.spp; s0 += per_chunk) tracer.trace_tile(ws, films, x0, y0, x1, y1, s0, std::min(per_chunk, opt.spp - s0), st);
         {
             std::lock_guard<std::mutex> lock(stats_mutex);
             total.camera_rays += st.camera_rays;
@@ -259,10 +309,47 @@ Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const Re
     });
     total.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats) *stats = total;
+}
+
+Camera render_camera(const Scene& scene, const RenderOptions& opt) {
+    return scene.camera.with_resolution(opt.width > 0 ? opt.width : scene.camera.width, opt.height > 0 ? opt.height : scene.camera.height);
+}
+
+}  // namespace
+
+template <int N>
+Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, RenderStats* stats) {
+    Camera camera = render_camera(scene, opt);
+    Film<N> film(camera.width, camera.height);
+    Film<N>* const films[3] = {&film, nullptr, nullptr};
+    render_tiles<N>(scene, spectra, nullptr, opt, camera, films, stats);
     return film;
+}
+
+template <int N>
+TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
+                                 const RenderOptions& opt, RenderStats* stats) {
+    if (terms.La.size() != scene.shapes.size() || terms.Lc.size() != scene.shapes.size())
+        throw std::invalid_argument("render_latent_terms: La/Lc must hold one vector per shape");
+    Camera camera = render_camera(scene, opt);
+    TermFilms<N> out{Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height)};
+    Film<N>* const films[3] = {&out.e, &out.a, &out.c};
+    render_tiles<N>(scene, spectra, &terms, opt, camera, films, stats);
+    return out;
+}
+
+template <int N>
+std::vector<float> TermFilms<N>::sum() const {
+    std::vector<float> s = e.develop(), a_img = a.develop(), c_img = c.develop();
+    for (size_t i = 0; i < s.size(); ++i) s[i] += a_img[i] + c_img[i];
+    return s;
 }
 
 template Film<3> render_path<3>(const Scene&, const SceneSpectra<3>&, const RenderOptions&, RenderStats*);
 template Film<16> render_path<16>(const Scene&, const SceneSpectra<16>&, const RenderOptions&, RenderStats*);
+template TermFilms<3> render_latent_terms<3>(const Scene&, const SceneSpectra<3>&, const LatentTerms<3>&, const RenderOptions&, RenderStats*);
+template TermFilms<16> render_latent_terms<16>(const Scene&, const SceneSpectra<16>&, const LatentTerms<16>&, const RenderOptions&, RenderStats*);
+template struct TermFilms<3>;
+template struct TermFilms<16>;
 
 }  // namespace lpt

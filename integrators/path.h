@@ -35,6 +35,30 @@ struct RenderStats {
 template <int N>
 Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& options, RenderStats* stats = nullptr);
 
+/// Ĩc's gate at the first non-delta vertex: add L̃c where the light sample is blocked (the
+/// paper's prose and public code; default) or where it is visible (the paper's equation, V).
+enum class OcclusionGate { Shadowed, Visible };
+
+/// The latent renderer's terms beyond light transport (docs/transport.md, latent section).
+template <int N>
+struct LatentTerms {
+    std::vector<Spectrum<N>, Eigen::aligned_allocator<Spectrum<N>>> La, Lc;  ///< per shape
+    Spectrum<N> background = Spectrum<N>::Zero();  ///< camera paths escaping along delta bounces
+    OcclusionGate gate = OcclusionGate::Shadowed;
+    bool emission = true, ambient = true, occlusion = true;  ///< which of Ĩe, Ĩa, Ĩc to render
+};
+
+template <int N>
+struct TermFilms {
+    Film<N> e, a, c;  ///< Ĩe (light transport), Ĩa (+ background), Ĩc
+    std::vector<float> sum() const;  ///< developed Ĩe + Ĩa + Ĩc, N floats per pixel
+};
+
+/// One pass that renders the three latent terms with the same paths (common random numbers).
+template <int N>
+TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
+                                 const RenderOptions& options, RenderStats* stats = nullptr);
+
 /// Power heuristic (beta = 2) of sampling technique a against b (both as solid-angle pdfs).
 inline float mis_power(float pdf_a, float pdf_b) {
     float a2 = pdf_a * pdf_a, b2 = pdf_b * pdf_b;

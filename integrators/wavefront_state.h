@@ -45,10 +45,13 @@ struct PathState {
     std::vector<float> prev_pdf;           ///< solid-angle pdf of the last BSDF sample (MIS)
     std::vector<uint8_t> prev_delta;       ///< last scattering was a delta lobe (or camera)
     AlignedVector<Vec3f> prev_p;           ///< last vertex position (area-light pdf on hits)
+    AlignedVector<Spectrum<N>> ambient, occlusion;  ///< latent Ĩa (+ background) and Ĩc
+    std::vector<uint8_t> past_first;       ///< the first non-delta vertex is behind us (latent)
 
     void resize(size_t n) {
         beta.resize(n); radiance.resize(n); pixel.resize(n); sample.resize(n);
         prev_pdf.resize(n); prev_delta.resize(n); prev_p.resize(n);
+        ambient.resize(n); occlusion.resize(n); past_first.resize(n);
     }
 };
 
@@ -60,12 +63,14 @@ struct ShadeQueue {
     AlignedVector<Vec3f> p, ng, wi;  ///< wi in the local shading frame
     std::vector<Frame> frame;
     AlignedVector<Vec2f> uv;
+    std::vector<uint8_t> flags;  ///< kContinue: NEE + BSDF sampling; kFirst: latent Ĩc gate here
+    static constexpr uint8_t kContinue = 1, kFirst = 2;
     size_t count = 0;
     void reset(size_t capacity) {
         count = 0;
         if (slot.size() >= capacity) return;
         slot.resize(capacity); shape.resize(capacity); p.resize(capacity); ng.resize(capacity);
-        wi.resize(capacity); frame.resize(capacity); uv.resize(capacity);
+        wi.resize(capacity); frame.resize(capacity); uv.resize(capacity); flags.resize(capacity);
     }
     size_t size() const { return count; }
 };
@@ -75,8 +80,9 @@ template <int N>
 struct ShadowQueue {
     RayArrays rays;
     std::vector<uint32_t> slot;
-    AlignedVector<Spectrum<N>> contribution;
-    void clear() { rays.clear(); slot.clear(); contribution.clear(); }
+    AlignedVector<Spectrum<N>> contribution;  ///< NEE: added if unblocked
+    AlignedVector<Spectrum<N>> occlusion;     ///< latent β·L̃c: added if the gate opens (else empty)
+    void clear() { rays.clear(); slot.clear(); contribution.clear(); occlusion.clear(); }
 };
 
 }  // namespace lpt

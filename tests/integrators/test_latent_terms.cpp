@@ -1,0 +1,139 @@
+// Latent terms Ĩe, Ĩa, Ĩc: linearity in L̃e/L̃a/L̃c (exact, same random numbers), analytic values
+// on a plane under a light, the occlusion gate both ways, the background, and Ĩe == the plain
+// path tracer.
+#include "integrators/path.h"
+#include "scene_fixtures.h"
+#include <gtest/gtest.h>
+
+using namespace lpt;
+
+namespace {
+
+using S16 = Spectrum<16>;
+
+S16 ramp(float a, float b) {
+    S16 s;
+    for (int c = 0; c < 16; ++c) s[c] = a + b * float(c) / 15.f;
+    return s;
+}
+
+LatentTerms<16> zero_terms(const Scene& scene) {
+    LatentTerms<16> t;
+    t.La.assign(scene.shapes.size(), S16::Zero());
+    t.Lc.assign(scene.shapes.size(), S16::Zero());
+    return t;
+}
+
+RenderOptions options(const Scene& scene, int spp = 4) {
+    RenderOptions o = RenderOptions::from_scene(scene);
+    o.spp = spp;
+    o.seed = 9;
+    return o;
+}
+
+float max_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
+    float m = 0;
+    for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+    return m;
+}
+
+float max_abs(const std::vector<float>& a) {
+    float m = 0;
+    for (float v : a) m = std::max(m, std::abs(v));
+    return m;
+}
+
+}  // namespace
+
+TEST(LatentTerms, EachTermIsLinearInItsVector) {
+    Scene scene = load_scene(test::cornell_box_path(), {{"camera.width", "12"}, {"camera.height", "12"}});
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    const S16 v1 = ramp(-0.7f, 1.3f), v2 = ramp(0.4f, -0.9f);
+    const int light = scene.shapes[scene.find_shape("light")].emitter;
+    auto render = [&](const S16& le, const S16& la, const S16& lc) {
+        auto sp = SceneSpectra<16>::from_description(scene);
+        sp.radiance[light] = le;
+        LatentTerms<16> t = zero_terms(scene);
+        for (auto& x : t.La) x = la;
+        for (auto& x : t.Lc) x = lc;
+        return render_latent_terms<16>(scene, sp, t, options(scene));
+    };
+    const S16 z = S16::Zero();
+    auto f1 = render(v1, v1, v1), f2 = render(v2, v2, v2), f12 = render(v1 + v2, v1 + v2, v1 + v2);
+    auto check = [&](const Film<16>& a, const Film<16>& b, const Film<16>& ab, const char* term) {
+        std::vector<float> sa = a.develop(), sb = b.develop(), sab = ab.develop();
+        for (size_t i = 0; i < sa.size(); ++i) sa[i] += sb[i];
+        EXPECT_LT(max_abs_diff(sa, sab), 1e-5f * (1.f + max_abs(sab))) << term;
+        EXPECT_GT(max_abs(sab), 1e-3f) << term << " is identically zero: the test would prove nothing";
+    };
+    check(f1.e, f2.e, f12.e, "Ie");
+    check(f1.a, f2.a, f12.a, "Ia");
+    check(f1.c, f2.c, f12.c, "Ic");
+    (void)z;
+}
+
+TEST(LatentTerms, EmissionTermIsThePlainPathTracer) {
+    Scene scene = load_scene(test::cornell_box_path(), {{"camera.width", "10"}, {"camera.height", "10"}});
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    auto films = render_latent_terms<16>(scene, spectra, zero_terms(scene), options(scene));
+    auto plain = render_path<16>(scene, spectra, options(scene)).develop();
+    EXPECT_EQ(films.e.develop(), plain);
+    EXPECT_EQ(max_abs(films.a.develop()), 0.f);
+    EXPECT_EQ(max_abs(films.c.develop()), 0.f);
+}
+
+TEST(LatentTerms, AmbientIsLaAtTheFirstDiffuseVertex) {
+    // Every pixel sees the diffuse plane directly: Ĩa = β · L̃a = L̃a exactly.
+    Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 1.f);
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    LatentTerms<16> t = zero_terms(scene);
+    const S16 la = ramp(-0.3f, 0.8f);
+    t.La[scene.find_shape("plane")] = la;
+    t.La[scene.find_shape("light")] = ramp(5.f, 1.f);  // never the first vertex here
+    t.emission = false;
+    auto img = render_latent_terms<16>(scene, spectra, t, options(scene)).a.develop();
+    for (size_t i = 0; i < img.size(); ++i) EXPECT_NEAR(img[i], la[int(i % 16)], 1e-6f);
+}
+
+TEST(LatentTerms, BackgroundForEscapingCameraRays) {
+    Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 1.f);
+    scene.camera.world_from_camera = Transform::look_at(Vec3f(5, 5, 5), Vec3f(10, 10, 10), Vec3f(0, 0, 1));  // looks at the sky
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    LatentTerms<16> t = zero_terms(scene);
+    t.background = ramp(0.2f, -0.6f);
+    auto img = render_latent_terms<16>(scene, spectra, t, options(scene)).a.develop();
+    for (size_t i = 0; i < img.size(); ++i) EXPECT_NEAR(img[i], t.background[int(i % 16)], 1e-6f);
+}
+
+TEST(LatentTerms, OcclusionGateBothWays) {
+    // Plane under a light, no occluder: every light sample is visible. Then a blocker between.
+    Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 1.f);
+    const S16 lc = ramp(0.5f, -1.f);
+    auto gate_images = [&](const Scene& sc) {
+        auto spectra = SceneSpectra<16>::from_description(sc);
+        LatentTerms<16> t = zero_terms(sc);
+        t.Lc[sc.find_shape("plane")] = lc;
+        t.gate = OcclusionGate::Shadowed;
+        auto shadowed = render_latent_terms<16>(sc, spectra, t, options(sc)).c.develop();
+        t.gate = OcclusionGate::Visible;
+        auto visible = render_latent_terms<16>(sc, spectra, t, options(sc)).c.develop();
+        return std::pair{shadowed, visible};
+    };
+    auto [sh_open, vis_open] = gate_images(scene);
+    for (size_t i = 0; i < sh_open.size(); ++i) {
+        EXPECT_NEAR(sh_open[i], 0.f, 1e-6f);
+        EXPECT_NEAR(vis_open[i], lc[int(i % 16)], 1e-6f);
+    }
+    Shape blocker;
+    blocker.id = "blocker";
+    blocker.mesh = make_rectangle();
+    blocker.mesh.transform(Transform::translate(Vec3f(0, 0, 0.75f)) * Transform::scale(Vec3f(5, 5, 1)));
+    blocker.material = scene.shapes[scene.find_shape("light")].material;
+    scene.shapes.push_back(std::move(blocker));
+    scene.build();
+    auto [sh_blocked, vis_blocked] = gate_images(scene);
+    for (size_t i = 0; i < sh_blocked.size(); ++i) {
+        EXPECT_NEAR(sh_blocked[i], lc[int(i % 16)], 1e-6f);
+        EXPECT_NEAR(vis_blocked[i], 0.f, 1e-6f);
+    }
+}
