@@ -71,6 +71,19 @@ public:
         throw std::invalid_argument("BSDF has no spectral coefficient '" + key + "'");
     }
 
+    /// ∂(f·|cos wo|)/∂c for the coefficient c = spectral_keys()[key], per channel, over the
+    /// non-delta lobes. f is affine in each coefficient, so this does not depend on c itself;
+    /// no division by f anywhere (docs/path-replay.md). Plugins without an analytic derivative
+    /// yet throw std::logic_error naming themselves.
+    virtual Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const {
+        throw std::logic_error("this BSDF type has no coefficient gradients yet");
+    }
+    /// ∂(bs.weight)/∂c for a sample this BSDF returned. Default: non-delta lobes, whose weight is
+    /// eval/pdf with a pdf that ignores the coefficients. BSDFs with delta lobes override it.
+    virtual Spectrum<N> weight_grad(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const {
+        return eval_grad(ctx, wi, bs.wo, key) / bs.pdf;
+    }
+
     bool has_delta() const { return (flags() & kDelta) != 0; }
     bool is_delta() const { return (flags() & kNonDelta) == 0; }
 };

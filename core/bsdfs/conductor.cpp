@@ -35,6 +35,11 @@ public:
     uint32_t flags() const override { return kDeltaReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_specular * m_ior.fresnel(1.f); }
 
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f&, const Vec3f&, int) const override { return Spectrum<N>::Zero(); }
+    Spectrum<N> weight_grad(const BSDFContext&, const Vec3f& wi, const BSDFSample<N>&, int) const override {
+        return Spectrum<N>::Ones() * m_ior.fresnel(cos_theta(wi));  // d/dR of (14)
+    }
+
     std::vector<std::string> spectral_keys() const override { return {"specular_reflectance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
         if (key != "specular_reflectance") BSDF<N>::set_spectral(key, v);

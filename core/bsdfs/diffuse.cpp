@@ -38,6 +38,11 @@ public:
     uint32_t flags() const override { return kDiffuseReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_reflectance; }
 
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int) const override {
+        if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
+        return Spectrum<N>::Constant(kInvPi * cos_theta(wo));
+    }
+
     std::vector<std::string> spectral_keys() const override { return {"reflectance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
         if (key != "reflectance") BSDF<N>::set_spectral(key, v);

@@ -41,6 +41,15 @@ public:
     uint32_t flags() const override { return m_nested->flags(); }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_nested->albedo(ctx); }
 
+    Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        return cos_theta(wi) < 0.f ? m_nested->eval_grad(ctx, flip_z(wi), flip_z(wo), key) : m_nested->eval_grad(ctx, wi, wo, key);
+    }
+    Spectrum<N> weight_grad(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const override {
+        if (cos_theta(wi) >= 0.f) return m_nested->weight_grad(ctx, wi, bs, key);
+        BSDFSample<N> flipped = bs;
+        flipped.wo = flip_z(bs.wo);
+        return m_nested->weight_grad(ctx, flip_z(wi), flipped, key);
+    }
     std::vector<std::string> spectral_keys() const override { return m_nested->spectral_keys(); }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override { m_nested->set_spectral(key, v); }
 

@@ -63,3 +63,39 @@ TEST(BSDFParams, EveryCoefficientEntersAffinely) {
         EXPECT_THROW(bsdf->set_spectral("no_such_key", Spectrum<16>::Zero()), std::invalid_argument) << type;
     }
 }
+
+TEST(BSDFParams, CoefficientGradientsMatchFiniteDifferences) {
+    // Differentiable plugins so far; the others must say so instead of returning garbage.
+    for (const char* type : {"diffuse", "conductor", "dielectric", "twosided"}) {
+        std::shared_ptr<Props> p = props(type);
+        if (std::string(type) == "twosided") p->values["bsdf"] = props("diffuse");
+        auto bsdf = make_bsdf<16>(*p);
+        auto keys = bsdf->spectral_keys();
+        for (int key = 0; key < int(keys.size()); ++key) {
+            const Spectrum<16> c = ramp(-0.4f, 0.9f);
+            const float h = 0.25f;  // affine: any step is exact up to rounding
+            for (uint32_t i = 0; i < 64; ++i) {
+                float z = (i % 2 ? 1.f : -1.f) * (0.2f + sample_1d(2, i, 0, 2));  // both faces
+                Vec3f wi = Vec3f(sample_1d(2, i, 0, 0) - 0.5f, sample_1d(2, i, 0, 1) - 0.5f, z).normalized();
+                float u1 = sample_1d(2, i, 0, 3);
+                Vec2f u2(sample_1d(2, i, 0, 4), sample_1d(2, i, 0, 5));
+                bsdf->set_spectral(keys[key], c);
+                BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, u1, u2);
+                if (!bs.valid()) continue;
+                Spectrum<16> g_eval = bsdf->eval_grad(BSDFContext{}, wi, bs.wo, key);
+                Spectrum<16> g_weight = bsdf->weight_grad(BSDFContext{}, wi, bs, key);
+                bsdf->set_spectral(keys[key], c + h);
+                BSDFSample<16> bp = bsdf->sample(BSDFContext{}, wi, u1, u2);
+                Spectrum<16> ep = bsdf->eval(BSDFContext{}, wi, bs.wo);
+                bsdf->set_spectral(keys[key], c - h);
+                BSDFSample<16> bm = bsdf->sample(BSDFContext{}, wi, u1, u2);
+                Spectrum<16> em = bsdf->eval(BSDFContext{}, wi, bs.wo);
+                Spectrum<16> fd_eval = (ep - em) / (2 * h), fd_weight = (bp.weight - bm.weight) / (2 * h);
+                EXPECT_LT((g_eval - fd_eval).abs().maxCoeff(), 1e-4f * (1.f + fd_eval.abs().maxCoeff())) << type << " " << keys[key];
+                EXPECT_LT((g_weight - fd_weight).abs().maxCoeff(), 1e-4f * (1.f + fd_weight.abs().maxCoeff())) << type << " " << keys[key];
+            }
+        }
+    }
+    auto rough = make_bsdf<16>(*props("roughconductor"));
+    EXPECT_THROW(rough->eval_grad(BSDFContext{}, Vec3f::UnitZ(), Vec3f::UnitZ(), 0), std::logic_error);
+}

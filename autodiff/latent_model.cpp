@@ -1,0 +1,88 @@
+#include "autodiff/latent_model.h"
+#include "core/sampler.h"
+#include <stdexcept>
+
+namespace lpt {
+
+Parameterisation parameterisation_from_string(const std::string& s) {
+    if (s == "paper") return Parameterisation::Paper;
+    if (s == "code") return Parameterisation::Code;
+    throw std::invalid_argument("unknown parameterisation '" + s + "' (known: paper, code)");
+}
+
+void split_materials_per_shape(Scene& scene) {
+    std::vector<Props> per_shape;
+    per_shape.reserve(scene.shapes.size());
+    for (Shape& s : scene.shapes) {
+        per_shape.push_back(scene.materials[s.material]);
+        s.material = int(per_shape.size()) - 1;
+    }
+    scene.materials = std::move(per_shape);
+}
+
+namespace {
+
+struct SliceSpec {
+    ParamMap map;
+    float lo, hi, init_a, init_b;
+};
+
+/// docs/params.md: the two parameterisations, per kind of vector.
+SliceSpec spec_for(Parameterisation p, bool reflectance_like) {
+    if (p == Parameterisation::Code)
+        return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f} : SliceSpec{ParamMap::Identity, -6.f, 6.f, -0.1f, 0.1f};
+    return reflectance_like ? SliceSpec{ParamMap::PosNeg, 0.f, 1.f, 0.f, 1.f} : SliceSpec{ParamMap::PosNeg, 0.f, 1e30f, 0.f, 1.f};
+}
+
+}  // namespace
+
+LatentModel::LatentModel(Scene& scene, Parameterisation p, uint64_t seed) : m_scene(scene) {
+    split_materials_per_shape(m_scene);
+    m_spectra = SceneSpectra<kLatentChannels>::from_description(m_scene);
+    m_slots.resize(m_scene.shapes.size());
+    auto add = [&](const std::string& name, const std::string& kind, bool refl) {
+        SliceSpec s = spec_for(p, refl);
+        int i = m_params.add(name, kind, s.map, kLatentChannels, s.lo, s.hi);
+        return i;
+    };
+    for (size_t i = 0; i < m_scene.shapes.size(); ++i) {
+        const Shape& shape = m_scene.shapes[i];
+        ShapeSlots& sl = m_slots[i];
+        if (shape.emitter >= 0) sl.Le = add(shape.id + ".Le", "Le", false);
+        const BSDF<kLatentChannels>& bsdf = *m_spectra.bsdfs[shape.material];
+        if (!bsdf.is_delta()) {
+            sl.La = add(shape.id + ".La", "La", false);
+            sl.Lc = add(shape.id + ".Lc", "Lc", false);
+        }
+        for (const std::string& key : bsdf.spectral_keys()) sl.bsdf.emplace_back(key, add(shape.id + ".bsdf." + key, "reflectance", true));
+    }
+    if (m_scene.environment >= 0) m_env_slot = add("environment.Le", "Le", false);
+    m_background = add("background", "background", false);
+
+    // Deterministic init: one seed, a distinct stream per kind.
+    const SliceSpec radiance = spec_for(p, false), refl = spec_for(p, true);
+    uint64_t k = 0;
+    for (const char* kind : {"Le", "La", "Lc", "background"}) m_params.init_uniform(kind, radiance.init_a, radiance.init_b, mix64(seed + ++k));
+    m_params.init_uniform("reflectance", refl.init_a, refl.init_b, mix64(seed + ++k));
+
+    m_terms.La.assign(m_scene.shapes.size(), Latent::Zero());
+    m_terms.Lc.assign(m_scene.shapes.size(), Latent::Zero());
+    sync();
+}
+
+void LatentModel::sync() {
+    m_params.update_values();
+    auto vec = [&](int slice) { return Eigen::Map<const Latent>(m_params.value(slice)); };
+    for (size_t i = 0; i < m_scene.shapes.size(); ++i) {
+        const ShapeSlots& sl = m_slots[i];
+        const Shape& shape = m_scene.shapes[i];
+        if (sl.Le >= 0) m_spectra.radiance[shape.emitter] = vec(sl.Le);
+        m_terms.La[i] = sl.La >= 0 ? Latent(vec(sl.La)) : Latent::Zero();
+        m_terms.Lc[i] = sl.Lc >= 0 ? Latent(vec(sl.Lc)) : Latent::Zero();
+        for (const auto& [key, slice] : sl.bsdf) m_spectra.bsdfs[shape.material]->set_spectral(key, vec(slice));
+    }
+    if (m_env_slot >= 0) m_spectra.radiance[m_scene.environment] = vec(m_env_slot);
+    m_terms.background = vec(m_background);
+}
+
+}  // namespace lpt
