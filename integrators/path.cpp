@@ -40,16 +40,17 @@ template <int N>
 class PathTracer {
 public:
     PathTracer(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, const Camera& camera,
-               const LatentTerms<N>* terms)
-        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_terms(terms),
+               const LatentTerms<N>* terms, PathObserver<N>* observer)
+        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_terms(terms), m_obs(observer),
           m_emission(!terms || terms->emission) {}
 
     /// Traces samples [s0, s0 + count) of every pixel in [x0,x1)×[y0,y1) and adds them to film.
     /// films[1], films[2] (Ĩa, Ĩc) are written only for latent terms.
-    void trace_tile(Workspace<N>& ws, Film<N>* const films[3], int x0, int y0, int x1, int y1, int s0, int count, RenderStats& st) const {
+    void trace_tile(Workspace<N>& ws, Film<N>* const films[3], int tile, int x0, int y0, int x1, int y1, int s0, int count, RenderStats& st) const {
         const int tile_pixels = (x1 - x0) * (y1 - y0);
         const size_t n = size_t(tile_pixels) * count;
         ws.paths.resize(n);
+        if (m_obs) m_obs->begin(tile, n);
         generate_camera_rays(ws, x0, y0, x1, s0, count, n, st);
         int cur = 0;
         for (int depth = 0; !ws.queue[cur].empty(); ++depth) {
@@ -65,6 +66,7 @@ public:
             st.extension_rays += ws.rays[1 - cur].size;
             cur = 1 - cur;
         }
+        if (m_obs) m_obs->end(ws.paths.pixel.data(), n);
         for (size_t k = 0; k < n; ++k) {
             films[0]->add_sample(int(ws.paths.pixel[k]), ws.paths.radiance[k]);
             if (m_terms) {
@@ -122,10 +124,16 @@ private:
         for (size_t i = 0; i < rays.size; ++i) {
             const uint32_t slot = ws.queue[cur][i];
             if (!rays.hit(i)) {
-                if (m_terms && m_terms->ambient && !p.past_first[slot]) p.ambient[slot] += p.beta[slot] * m_terms->background;
+                if (m_terms && m_terms->ambient && !p.past_first[slot]) {
+                    p.ambient[slot] += p.beta[slot] * m_terms->background;
+                    if (m_obs) m_obs->ambient(slot, -1, p.beta[slot]);
+                }
                 if (env < 0 || !m_emission) continue;
                 float w = hit_weight(p, slot, m_scene.lights.pmf(env) * pdf_constant_light());
-                if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[env]);
+                if (w > 0.f) {
+                    p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[env]);
+                    if (m_obs) m_obs->emission(slot, env, p.beta[slot], w);
+                }
                 continue;
             }
             const int shape_id = int(rays.geom[i]);
@@ -137,7 +145,10 @@ private:
                 if (ne.dot(wi_world) > 0.f) {
                     float light_pdf = m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
                     float w = hit_weight(p, slot, light_pdf);
-                    if (w > 0.f) p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
+                    if (w > 0.f) {
+                        p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
+                        if (m_obs) m_obs->emission(slot, shape.emitter, p.beta[slot], w);
+                    }
                 }
             }
             // Latent: Ĩa at the first non-delta vertex of E S* D, and flag it for Ĩc's gate.
@@ -145,7 +156,10 @@ private:
             if (m_terms && !p.past_first[slot] && !m_spectra.is_delta(m_scene, shape_id)) {
                 first = true;
                 p.past_first[slot] = 1;
-                if (m_terms->ambient) p.ambient[slot] += p.beta[slot] * m_terms->La[shape_id];
+                if (m_terms->ambient) {
+                    p.ambient[slot] += p.beta[slot] * m_terms->La[shape_id];
+                    if (m_obs) m_obs->ambient(slot, shape_id, p.beta[slot]);
+                }
             }
             // Without Ĩe nothing is collected after the first non-delta vertex.
             const bool cont = may_continue && (m_emission || !p.past_first[slot]);
@@ -179,6 +193,7 @@ private:
             const bool gate_shadowed = m_terms && m_terms->gate == OcclusionGate::Shadowed;
             if (m_scene.lights.empty()) {  // no light: everything is in shadow
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
+                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
@@ -189,18 +204,22 @@ private:
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
             if (!ls.valid() || sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f) {
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
+                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
             Spectrum<N> contribution = Spectrum<N>::Zero();
+            BSDFContext ctx;
+            ctx.uv = sq.uv[k];
+            const Vec3f wo = sq.frame[k].to_local(ls.wi);
+            float w_over_pdf = 0.f;
             if (nee) {
                 const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
-                BSDFContext ctx;
-                ctx.uv = sq.uv[k];
-                const Vec3f wo = sq.frame[k].to_local(ls.wi);
                 Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
-                if ((f != 0.f).any()) {
+                // A zero f (a latent reflectance at 0) still has a derivative: keep it for the adjoint.
+                if ((f != 0.f).any() || m_obs) {
                     float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
-                    contribution = p.beta[slot] * f * m_spectra.radiance[ls.emitter] * (w / ls.pdf);
+                    w_over_pdf = w / ls.pdf;
+                    contribution = p.beta[slot] * f * m_spectra.radiance[ls.emitter] * w_over_pdf;
                 } else if (!first) {
                     continue;
                 }
@@ -217,6 +236,7 @@ private:
                 dir = d / dist;
                 tmax = dist * (1.f - 1e-4f);
             }
+            if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, p.beta[slot], w_over_pdf, ctx, sq.wi[k], wo, nee, first);
             ws.shadow.rays.push(o, dir, 0.f, tmax);
             ws.shadow.slot.push_back(slot);
             ws.shadow.contribution.push_back(contribution);
@@ -240,12 +260,15 @@ private:
             if (!bs.valid()) continue;
             Spectrum<N> beta = p.beta[slot] * bs.weight;
             // |throughput|: sign-safe for latent spectra.
+            float q = 1.f;
             if (depth + 1 >= m_opt.rr_depth) {
-                float q = std::min(beta.abs().maxCoeff(), 0.95f);
+                q = std::min(beta.abs().maxCoeff(), 0.95f);
                 if (rng.get(dim::bounce(depth, dim::kRR)) >= q) continue;
                 beta /= q;
             }
-            if (!(beta != 0.f).any()) continue;
+            // A zero throughput contributes nothing but may still have a derivative.
+            if (!(beta != 0.f).any() && !m_obs) continue;
+            if (m_obs) m_obs->bounce(slot, sq.shape[k], p.beta[slot], ctx, sq.wi[k], bs, q);
             const Vec3f wo_world = sq.frame[k].to_world(bs.wo);
             p.beta[slot] = beta;
             p.prev_pdf[slot] = bs.pdf;
@@ -262,6 +285,7 @@ private:
         st.shadow_rays += sq.rays.size;
         for (size_t j = 0; j < sq.rays.size; ++j) {
             const bool blocked = sq.rays.blocked(j);
+            if (m_obs) m_obs->shadow(int(j), blocked);
             if (!blocked) ws.paths.radiance[sq.slot[j]] += sq.contribution[j];
             if (m_terms && blocked == (m_terms->gate == OcclusionGate::Shadowed)) ws.paths.occlusion[sq.slot[j]] += sq.occlusion[j];
         }
@@ -272,13 +296,14 @@ private:
     const RenderOptions& m_opt;
     const Camera& m_camera;
     const LatentTerms<N>* m_terms;  ///< null for plain (RGB) rendering
+    PathObserver<N>* m_obs;         ///< null unless an adjoint is replaying
     const bool m_emission;          ///< Ĩe on
 };
 
 /// Shared driver: tiles in parallel, each tile's pixels owned by one task (deterministic).
 template <int N>
-void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>* terms, const RenderOptions& opt,
-                  const Camera& camera, Film<N>* const films[3], RenderStats* stats) {
+void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>* terms, PathObserver<N>* observer,
+                  const RenderOptions& opt, const Camera& camera, Film<N>* const films[3], RenderStats* stats) {
     auto t0 = std::chrono::steady_clock::now();
     const int tiles_x = (camera.width + kTile - 1) / kTile, tiles_y = (camera.height + kTile - 1) / kTile;
     const int n_tiles = tiles_x * tiles_y;
@@ -287,7 +312,7 @@ void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const Late
     std::atomic<uint64_t> rays_done{0};
     std::mutex stats_mutex;
     RenderStats total;
-    const PathTracer<N> tracer(scene, spectra, opt, camera, terms);
+    const PathTracer<N> tracer(scene, spectra, opt, camera, terms, observer);
 
     tbb::parallel_for(0, n_tiles, [&](int t) {
         set_ftz_daz();
@@ -296,7 +321,7 @@ void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const Late
         int x1 = std::min(x0 + kTile, camera.width), y1 = std::min(y0 + kTile, camera.height);
         int per_chunk = std::max(1, int(kWavefront / size_t((x1 - x0) * (y1 - y0))));
         RenderStats st;
-        for (int s0 = 0; s0 < opt.spp; s0 += per_chunk) tracer.trace_tile(ws, films, x0, y0, x1, y1, s0, std::min(per_chunk, opt.spp - s0), st);
+        for (int s0 = 0; s0 < opt.spp; s0 += per_chunk) tracer.trace_tile(ws, films, t, x0, y0, x1, y1, s0, std::min(per_chunk, opt.spp - s0), st);
         {
             std::lock_guard<std::mutex> lock(stats_mutex);
             total.camera_rays += st.camera_rays;
@@ -322,19 +347,19 @@ Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const Re
     Camera camera = render_camera(scene, opt);
     Film<N> film(camera.width, camera.height);
     Film<N>* const films[3] = {&film, nullptr, nullptr};
-    render_tiles<N>(scene, spectra, nullptr, opt, camera, films, stats);
+    render_tiles<N>(scene, spectra, nullptr, nullptr, opt, camera, films, stats);
     return film;
 }
 
 template <int N>
 TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
-                                 const RenderOptions& opt, RenderStats* stats) {
+                                 const RenderOptions& opt, RenderStats* stats, PathObserver<N>* observer) {
     if (terms.La.size() != scene.shapes.size() || terms.Lc.size() != scene.shapes.size())
         throw std::invalid_argument("render_latent_terms: La/Lc must hold one vector per shape");
     Camera camera = render_camera(scene, opt);
     TermFilms<N> out{Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height)};
     Film<N>* const films[3] = {&out.e, &out.a, &out.c};
-    render_tiles<N>(scene, spectra, &terms, opt, camera, films, stats);
+    render_tiles<N>(scene, spectra, &terms, observer, opt, camera, films, stats);
     return out;
 }
 
@@ -347,8 +372,8 @@ std::vector<float> TermFilms<N>::sum() const {
 
 template Film<3> render_path<3>(const Scene&, const SceneSpectra<3>&, const RenderOptions&, RenderStats*);
 template Film<16> render_path<16>(const Scene&, const SceneSpectra<16>&, const RenderOptions&, RenderStats*);
-template TermFilms<3> render_latent_terms<3>(const Scene&, const SceneSpectra<3>&, const LatentTerms<3>&, const RenderOptions&, RenderStats*);
-template TermFilms<16> render_latent_terms<16>(const Scene&, const SceneSpectra<16>&, const LatentTerms<16>&, const RenderOptions&, RenderStats*);
+template TermFilms<3> render_latent_terms<3>(const Scene&, const SceneSpectra<3>&, const LatentTerms<3>&, const RenderOptions&, RenderStats*, PathObserver<3>*);
+template TermFilms<16> render_latent_terms<16>(const Scene&, const SceneSpectra<16>&, const LatentTerms<16>&, const RenderOptions&, RenderStats*, PathObserver<16>*);
 template struct TermFilms<3>;
 template struct TermFilms<16>;
 

@@ -6,6 +6,7 @@
 #include "core/film.h"
 #include "core/scene.h"
 #include "core/scene_spectra.h"
+#include "integrators/path_observer.h"
 #include <cstdint>
 #include <functional>
 
@@ -55,9 +56,12 @@ struct TermFilms {
 };
 
 /// One pass that renders the three latent terms with the same paths (common random numbers).
+/// With an observer, every path also reports its events (the adjoint's replay); the observer must
+/// be safe to call from several threads for different tiles. Zero-valued NEE samples and
+/// zero-throughput bounces are then kept, since their derivatives need not be zero.
 template <int N>
 TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
-                                 const RenderOptions& options, RenderStats* stats = nullptr);
+                                 const RenderOptions& options, RenderStats* stats = nullptr, PathObserver<N>* observer = nullptr);
 
 /// Power heuristic (beta = 2) of sampling technique a against b (both as solid-angle pdfs).
 inline float mis_power(float pdf_a, float pdf_b) {

@@ -1,0 +1,169 @@
+// Path replay gradients against central finite differences of the primal renderer, for every
+// parameter kind, with common random numbers. Loss = Σ W · Ĩ with fixed random weights W, so
+// d_image = W. Russian roulette is off: its survival probability depends on |β| and would make
+// the primal discontinuous in the reflectances.
+#include "autodiff/latent_path_adjoint.h"
+#include "core/sampler.h"
+#include "core/scene_loader.h"
+#include "test_util.h"
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <cmath>
+
+using namespace lpt;
+
+namespace {
+
+Scene small_cornell(int max_depth = 4) {
+    return load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
+                      {{"camera.width", "8"}, {"camera.height", "8"}, {"integrator.max_depth", std::to_string(max_depth)}, {"integrator.rr_depth", "100"}});
+}
+
+RenderOptions opts(const Scene& s) {
+    RenderOptions o = RenderOptions::from_scene(s);
+    o.spp = 4;
+    o.seed = 3;
+    return o;
+}
+
+std::vector<float> weights(size_t n) {
+    std::vector<float> w(n);
+    for (size_t i = 0; i < n; ++i) w[i] = 2.f * sample_1d(77, uint32_t(i), 0, 0) - 1.f;
+    return w;
+}
+
+double loss(LatentModel& m, const RenderOptions& o, const std::vector<float>& w) {
+    m.sync();
+    auto img = render_latent_terms<kLatentChannels>(m.scene(), m.spectra(), m.terms(), o).sum();
+    double l = 0;
+    for (size_t i = 0; i < img.size(); ++i) l += double(w[i]) * img[i];
+    return l;
+}
+
+/// Checks grad_values of every slice (channels 0, 7, 15) against central differences of the
+/// values: step 0.1 for the vectors Ĩ is linear in (exact up to rounding), 1e-2 for BSDF
+/// coefficients (Ĩ is a polynomial in them; truncation ~h^2). Tolerance: relative `tol`, with a
+/// floor of 1e-2 of the largest derivative so that rounding in near-zero ones does not count.
+void check_all_slices(LatentModel& m, const RenderOptions& o, double tol) {
+    const std::vector<float> w = weights(size_t(m.scene().camera.width) * m.scene().camera.height * kLatentChannels);
+    m.params().zero_grad();
+    backward_latent(m, o, w);
+    const std::vector<float> grad = m.params().grad_values();
+    struct Check { std::string what; double g, fd; };
+    std::vector<Check> checks;
+    for (size_t si = 0; si < m.params().slice_count(); ++si) {
+        const ParamSlice& sl = m.params().slice(int(si));
+        const float h = sl.kind == "reflectance" ? 1e-2f : 0.1f;
+        for (int c : {0, 7, 15}) {
+            std::vector<float> v(m.params().value(int(si)), m.params().value(int(si)) + sl.channels);
+            const float v0 = v[c];
+            v[c] = v0 + h;
+            m.params().set_value(int(si), v.data());
+            double lp = loss(m, o, w);
+            v[c] = v0 - h;
+            m.params().set_value(int(si), v.data());
+            double lm = loss(m, o, w);
+            v[c] = v0;
+            m.params().set_value(int(si), v.data());
+            checks.push_back({sl.name + " channel " + std::to_string(c), grad[sl.value_offset + c], (lp - lm) / (2.0 * h)});
+        }
+    }
+    m.sync();
+    double largest = 0;
+    for (const Check& k : checks) largest = std::max(largest, std::abs(k.fd));
+    ASSERT_GT(largest, 1e-3);
+    int nonzero = 0;
+    for (const Check& k : checks) {
+        EXPECT_NEAR(k.g, k.fd, tol * std::max(std::abs(k.fd), 1e-2 * largest)) << k.what;
+        nonzero += std::abs(k.fd) > 1e-2 * largest;
+    }
+    EXPECT_GT(nonzero, int(checks.size()) / 2) << "most derivatives are ~0: the scene does not exercise the parameters";
+}
+
+/// The Cornell box with a mirror tall block and a glass short block: delta bounces before the
+/// first non-delta vertex (Ĩa, Ĩc behind them) and delta coefficient gradients.
+Scene cornell_with_delta_blocks() {
+    Scene s = small_cornell(5);
+    Props mirror;
+    mirror.type = "conductor";
+    mirror.file = "test";
+    Props glass;
+    glass.type = "dielectric";
+    glass.file = "test";
+    s.materials.push_back(mirror);
+    s.shapes[s.find_shape("tall_block")].material = int(s.materials.size()) - 1;
+    s.materials.push_back(glass);
+    s.shapes[s.find_shape("short_block")].material = int(s.materials.size()) - 1;
+    return s;
+}
+
+}  // namespace
+
+TEST(LatentAdjoint, GradientsMatchFiniteDifferencesCodeParameterisation) {
+    Scene scene = small_cornell();
+    LatentModel m(scene, Parameterisation::Code, 1);
+    check_all_slices(m, opts(scene), 1e-3);
+}
+
+TEST(LatentAdjoint, GradientsMatchFiniteDifferencesVisibleGateAndMis) {
+    Scene scene = small_cornell(3);
+    LatentModel m(scene, Parameterisation::Paper, 2);
+    m.terms().gate = OcclusionGate::Visible;
+    check_all_slices(m, opts(scene), 1e-3);
+}
+
+TEST(LatentAdjoint, GradientsMatchFiniteDifferencesThroughMirrorAndGlass) {
+    Scene scene = cornell_with_delta_blocks();
+    LatentModel m(scene, Parameterisation::Code, 6);
+    RenderOptions o = opts(scene);
+    o.spp = 16;
+    check_all_slices(m, o, 1e-3);
+}
+
+TEST(LatentAdjoint, ZeroReflectanceKeepsItsGradient) {
+    Scene scene = small_cornell();
+    LatentModel m(scene, Parameterisation::Paper, 3);
+    const int floor_refl = m.params().find("floor.bsdf.reflectance");
+    ASSERT_GE(floor_refl, 0);
+    std::vector<float> zero(kLatentChannels, 0.f);
+    m.params().set_value(floor_refl, zero.data());
+    m.sync();
+    RenderOptions o = opts(scene);
+    const std::vector<float> w = weights(size_t(scene.camera.width) * scene.camera.height * kLatentChannels);
+    m.params().zero_grad();
+    backward_latent(m, o, w);
+    const ParamSlice& sl = m.params().slice(floor_refl);
+    double norm = 0;
+    for (int c = 0; c < kLatentChannels; ++c) norm += std::abs(m.params().grad_values()[sl.value_offset + c]);
+    EXPECT_GT(norm, 1e-4) << "a reflectance at exactly 0 lost its gradient";
+    check_all_slices(m, o, 1e-3);
+}
+
+TEST(LatentAdjoint, ReplayImageAndGradientsIndependentOfThreads) {
+    Scene scene = small_cornell();
+    LatentModel m(scene, Parameterisation::Code, 4);
+    RenderOptions o = opts(scene);
+    const std::vector<float> w = weights(size_t(scene.camera.width) * scene.camera.height * kLatentChannels);
+    auto primal = render_latent_terms<kLatentChannels>(m.scene(), m.spectra(), m.terms(), o).sum();
+    std::vector<float> g1, g2, img1;
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+        m.params().zero_grad();
+        img1 = backward_latent(m, o, w);
+        g1 = m.params().grad_values();
+    }
+    {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        m.params().zero_grad();
+        backward_latent(m, o, w);
+        g2 = m.params().grad_values();
+    }
+    EXPECT_EQ(img1, primal);
+    EXPECT_EQ(g1, g2);
+}
+
+TEST(LatentAdjoint, RejectsWrongGradientShape) {
+    Scene scene = small_cornell();
+    LatentModel m(scene, Parameterisation::Code, 5);
+    EXPECT_THROW(backward_latent(m, opts(scene), std::vector<float>(10)), std::invalid_argument);
+}
