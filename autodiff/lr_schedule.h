@@ -55,6 +55,13 @@ public:
     double best_loss() const { return m_best_loss; }
     /// Consecutive non-improving updates since the last improvement.
     int bad_updates() const { return m_bad_updates; }
+    /// Puts back the state a checkpoint recorded (resumed fits stop where uninterrupted ones do).
+    void restore(double best_loss, int best_iteration, int bad_updates) {
+        m_best_loss = best_loss;
+        m_best_iteration = best_iteration;
+        m_bad_updates = bad_updates;
+        m_improved = false;
+    }
 
 private:
     int m_patience;

@@ -1,0 +1,167 @@
+#include "autodiff/fit.h"
+#include "autodiff/latent_path_adjoint.h"
+#include "autodiff/loss.h"
+#include "autodiff/lr_schedule.h"
+#include "core/image_io.h"
+#include "core/sampler.h"
+#include <nlohmann/json.hpp>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace lpt {
+
+namespace {
+
+RenderOptions iteration_options(const LatentModel& model, const FitOptions& o, int width, int height, int iteration) {
+    RenderOptions r = RenderOptions::from_scene(model.scene());
+    r.spp = o.spp;
+    r.width = width;
+    r.height = height;
+    // A new, reproducible set of paths per iteration: resumed fits replay the same ones.
+    r.seed = mix64(o.seed * 0x9e3779b97f4a7c15ULL + uint64_t(iteration) + 1);
+    return r;
+}
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path + ": cannot open checkpoint file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+}  // namespace
+
+std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone) {
+    std::vector<float> img = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), options).sum();
+    tone_map(tone, img.data(), img.data(), img.size());
+    return img;
+}
+
+FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o, FitState state,
+                    const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
+    const size_t n = size_t(width) * height * kLatentChannels;
+    if (target.size() != n) throw std::invalid_argument("fit: target has " + std::to_string(target.size()) + " values, expected " + std::to_string(n));
+    size_t bad_index = 0;
+    if (!check_finite(target.data(), n, &bad_index))
+        throw std::invalid_argument("fit: target value " + std::to_string(bad_index) + " (pixel " + std::to_string(bad_index / kLatentChannels) +
+                                    ", channel " + std::to_string(bad_index % kLatentChannels) + ") is not finite");
+    ParamStore& ps = model.params();
+    Adam adam(ps.raw().size());
+    if (!state.adam.m.empty()) adam.set_state(state.adam);
+    CosineWarmRestarts schedule(o.lr, o.lr_period, o.lr_t_mult, o.lr_min);
+    EarlyStopping stopper(std::max(1, o.patience), o.min_delta);
+    stopper.restore(state.best_loss, state.best_iteration, state.bad_updates);
+    if (state.best_raw.empty()) state.best_raw = ps.raw();
+
+    std::vector<float> d_toned(n), d_image(n);
+    auto t0 = std::chrono::steady_clock::now();
+    double seconds_before = state.history.empty() ? 0.0 : state.history.back().seconds;
+    for (int it = state.next_iteration; it < o.iterations; ++it) {
+        RenderOptions ro = iteration_options(model, o, width, height, it);
+        // Primal: docs/fitting.md (7) on the tone-mapped latent.
+        std::vector<float> linear = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro).sum();
+        std::vector<float> toned(n);
+        tone_map(o.tone, linear.data(), toned.data(), n);
+        double loss = huber_loss(toned.data(), target.data(), n, o.huber_delta, d_toned.data());
+        tone_map_backward(o.tone, linear.data(), d_toned.data(), d_image.data(), n);
+        // Adjoint: path replay with the same options (same random numbers).
+        ps.zero_grad();
+        backward_latent(model, ro, d_image);
+        ps.backward();
+        const float lr = schedule.lr_at(it);
+        size_t bad = adam.step(ps.raw().data(), ps.grad_raw().data(), ps.raw().size(), lr);
+        if (bad) ++state.skipped_steps;  // the step was refused: parameters untouched
+        ps.clamp_raw();
+        model.sync();
+
+        state.smoothed = state.smoothed < 0 ? loss : o.smoothing * state.smoothed + (1.0 - o.smoothing) * loss;
+        bool stop = o.patience > 0 && stopper.update(state.smoothed, it);
+        if (stopper.improved() || o.patience == 0) state.best_raw = ps.raw();
+        state.best_loss = stopper.best_loss();
+        state.best_iteration = stopper.best_iteration();
+        state.bad_updates = stopper.bad_updates();
+        state.next_iteration = it + 1;
+        state.adam = adam.state();
+        double secs = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        FitRecord rec{it, loss, state.smoothed, lr, secs};
+        state.history.push_back(rec);
+        if (o.checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % o.checkpoint_every == 0) save_checkpoint(o.checkpoint_dir, model, state);
+        if (on_iteration && !on_iteration(rec, state)) break;
+        if (stop) break;
+    }
+    // Early stopping restores the best parameters for real.
+    ps.raw() = state.best_raw;
+    ps.update_values();
+    model.sync();
+    return state;
+}
+
+void save_checkpoint(const std::string& dir, const LatentModel& model, const FitState& s) {
+    namespace fs = std::filesystem;
+    fs::create_directories(dir);
+    nlohmann::json j;
+    j["next_iteration"] = s.next_iteration;
+    j["smoothed"] = s.smoothed;
+    j["best_loss"] = s.best_loss;
+    j["best_iteration"] = s.best_iteration;
+    j["bad_updates"] = s.bad_updates;
+    j["skipped_steps"] = s.skipped_steps;
+    j["best_raw"] = s.best_raw;
+    j["history"] = nlohmann::json::array();
+    for (const FitRecord& r : s.history) j["history"].push_back({r.iteration, r.loss, r.smoothed, r.lr, r.seconds});
+    // Each file is written atomically; params and Adam state carry the iteration in their names
+    // and state.json, written last, names them: a run killed at any point leaves either the old
+    // or the new checkpoint complete, never a mix.
+    const std::string tag = std::to_string(s.next_iteration);
+    j["tag"] = tag;
+    write_text_atomic((fs::path(dir) / ("params-" + tag + ".json")).string(), model.params().to_json());
+    write_text_atomic((fs::path(dir) / ("adam-" + tag + ".bin")).string(), serialize_adam_state(s.adam));
+    write_text_atomic((fs::path(dir) / "state.json").string(), j.dump());
+    for (const auto& entry : fs::directory_iterator(dir)) {
+        const std::string name = entry.path().filename().string();
+        bool ours = name.rfind("params-", 0) == 0 || name.rfind("adam-", 0) == 0;
+        if (ours && name != "params-" + tag + ".json" && name != "adam-" + tag + ".bin") fs::remove(entry.path());
+    }
+}
+
+FitState load_checkpoint(const std::string& dir, LatentModel& model) {
+    namespace fs = std::filesystem;
+    const std::string state_path = (fs::path(dir) / "state.json").string();
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(read_file(state_path));
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(state_path + ": malformed checkpoint: " + e.what());
+    }
+    FitState s;
+    try {
+        s.next_iteration = j.at("next_iteration");
+        s.smoothed = j.at("smoothed");
+        s.best_loss = j.at("best_loss");
+        s.best_iteration = j.at("best_iteration");
+        s.bad_updates = j.at("bad_updates");
+        s.skipped_steps = j.at("skipped_steps");
+        s.best_raw = j.at("best_raw").get<std::vector<float>>();
+        for (const auto& r : j.at("history")) s.history.push_back({r.at(0).get<int>(), r.at(1).get<double>(), r.at(2).get<double>(), r.at(3).get<float>(), r.at(4).get<double>()});
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(state_path + ": incomplete checkpoint: " + e.what());
+    }
+    const std::string tag = j.value("tag", std::string());
+    const std::string params_path = (fs::path(dir) / ("params-" + tag + ".json")).string();
+    model.params().load_json(read_file(params_path), params_path);
+    if (s.best_raw.size() != model.params().raw().size()) throw std::runtime_error(state_path + ": best_raw does not match this scene's parameters");
+    model.params().update_values();
+    model.sync();
+    try {
+        s.adam = deserialize_adam_state(read_file((fs::path(dir) / ("adam-" + tag + ".bin")).string()));
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error((fs::path(dir) / ("adam-" + tag + ".bin")).string() + ": " + e.what());
+    }
+    return s;
+}
+
+}  // namespace lpt

@@ -1,0 +1,61 @@
+// Stage 1 of `latentpt fit`: per-shape latent parameters fitted to a target latent map by Adam
+// on the Huber loss of the tone-mapped render, with path-replay gradients, cosine annealing with
+// warm restarts, early stopping that restores the best parameters, and checkpoints that resume to
+// the same result as an uninterrupted run. docs/fitting.md.
+#pragma once
+#include "autodiff/adam.h"
+#include "autodiff/latent_model.h"
+#include "autodiff/tone_curve.h"
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace lpt {
+
+struct FitOptions {
+    int iterations = 3000;
+    int spp = 16;                 ///< per iteration, fresh random numbers each iteration
+    uint64_t seed = 0;
+    float lr = 1e-3f, lr_min = 0.f;
+    int lr_period = 500, lr_t_mult = 1;
+    float huber_delta = 1.f;
+    ToneCurve tone = ToneCurve::Clip;
+    int patience = 300;           ///< early stopping on the smoothed loss; 0 = off
+    float min_delta = 1e-5f;
+    float smoothing = 0.95f;      ///< exponential moving average of the noisy per-iteration loss
+    int checkpoint_every = 100;   ///< 0 = never
+    std::string checkpoint_dir;   ///< empty = no checkpoints
+};
+
+struct FitRecord {
+    int iteration;
+    double loss, smoothed;
+    float lr;
+    double seconds;
+};
+
+struct FitState {
+    int next_iteration = 0;
+    AdamState adam;
+    double smoothed = -1.0;       ///< < 0 before the first iteration
+    double best_loss = 1e300;
+    int best_iteration = -1, bad_updates = 0;
+    std::vector<float> best_raw;  ///< the parameters at best_iteration
+    int skipped_steps = 0;        ///< iterations whose gradient had NaN/Inf (step refused)
+    std::vector<FitRecord> history;
+};
+
+/// Latent render with the fit's tone curve applied: what the loss compares with the target.
+std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone);
+
+/// Runs (or continues, from `state`) the fit; ends with the best parameters in `model`.
+/// `on_iteration` is called after every iteration (progress, logging); returning false stops.
+FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& options,
+                    FitState state = {}, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration = {});
+
+/// Checkpoint = params (raw) + Adam state + early-stopping state + history, written atomically
+/// into `dir`; load throws std::runtime_error naming the file on any mismatch.
+void save_checkpoint(const std::string& dir, const LatentModel& model, const FitState& state);
+FitState load_checkpoint(const std::string& dir, LatentModel& model);
+
+}  // namespace lpt
