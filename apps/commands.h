@@ -32,6 +32,20 @@ struct BenchArgs {
 };
 int run_bench(const BenchArgs& args);
 
+struct FitArgs {
+    std::string scene, target, out = "fit-out";
+    std::string synthetic_res = "32x32";  ///< used when no --target is given
+    uint64_t synthetic_seed = 1;
+    int iterations = 3000, spp = 16, final_spp = 256;
+    uint64_t seed = 0;
+    float lr = 1e-3f, lr_min = 0.f, min_delta = 1e-5f;
+    int lr_period = 500, patience = 300, checkpoint_every = 100;
+    std::string tone = "clip", param = "code", gate = "shadowed", terms = "eac";
+    bool resume = false, quiet = false;
+    std::map<std::string, std::string> defines;
+};
+int run_fit(const FitArgs& args);
+
 /// Parses "WxH"; throws std::invalid_argument with a clear message.
 void parse_resolution(const std::string& s, int& w, int& h);
 

@@ -37,6 +37,33 @@ int main(int argc, char** argv) {
     bench->add_option("--sphere-triangles", b.sphere_triangles, "triangles of the sphere added for the heavy-scene run")->capture_default_str();
     bench->add_option("--json", b.out_json, "also write the results as JSON");
 
+    FitArgs f;
+    std::vector<std::string> fit_defines;
+    auto* fit = app.add_subcommand("fit", "fit per-shape latent parameters to a target latent map (stage 1)");
+    fit->add_option("scene", f.scene, "scene file (.json or Mitsuba 3 .xml)")->required()->check(CLI::ExistingFile);
+    fit->add_option("--target", f.target, "16-channel float EXR at latent resolution (channels C0..C15); "
+                                          "without it, a synthetic target rendered from random parameters")->check(CLI::ExistingFile);
+    fit->add_option("-o,--out", f.out, "output folder")->capture_default_str();
+    fit->add_option("--synthetic-res", f.synthetic_res, "latent resolution WxH of the synthetic target")->capture_default_str();
+    fit->add_option("--synthetic-seed", f.synthetic_seed, "seed of the synthetic target's parameters")->capture_default_str();
+    fit->add_option("--iterations", f.iterations, "optimiser steps")->capture_default_str();
+    fit->add_option("--spp", f.spp, "samples per pixel per iteration")->capture_default_str();
+    fit->add_option("--final-spp", f.final_spp, "samples per pixel of the final render")->capture_default_str();
+    fit->add_option("--seed", f.seed, "seed of the initial parameters and of every iteration's paths")->capture_default_str();
+    fit->add_option("--lr", f.lr, "Adam learning rate (cosine annealing with warm restarts)")->capture_default_str();
+    fit->add_option("--lr-min", f.lr_min, "minimum learning rate of the schedule")->capture_default_str();
+    fit->add_option("--lr-period", f.lr_period, "iterations per restart period")->capture_default_str();
+    fit->add_option("--patience", f.patience, "early stopping: iterations without improvement of the smoothed loss; 0 = off")->capture_default_str();
+    fit->add_option("--min-delta", f.min_delta, "early stopping: smallest improvement that counts")->capture_default_str();
+    fit->add_option("--tone", f.tone, "signed tone curve: clip or reinhard")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
+    fit->add_option("--param", f.param, "parameterisation: code (public code) or paper (paper text)")->check(CLI::IsMember({"code", "paper"}))->capture_default_str();
+    fit->add_option("--gate", f.gate, "Ic gate: shadowed (1 - V) or visible (V)")->check(CLI::IsMember({"shadowed", "visible"}))->capture_default_str();
+    fit->add_option("--terms", f.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
+    fit->add_option("--checkpoint-every", f.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();
+    fit->add_flag("--resume", f.resume, "continue from <out>/checkpoint");
+    fit->add_option("-D,--define", fit_defines, "override a scene value (as for render)");
+    fit->add_flag("-q,--quiet", f.quiet, "no progress line");
+
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
@@ -50,6 +77,16 @@ int main(int argc, char** argv) {
             return run_render(r);
         }
         if (*bench) return run_bench(b);
+        if (*fit) {
+            for (const auto& d : fit_defines) {
+                auto eq = d.find('=');
+                if (eq == std::string::npos) throw std::invalid_argument("-D expects key=value, got '" + d + "'");
+                f.defines[d.substr(0, eq)] = d.substr(eq + 1);
+            }
+            if (f.terms.find_first_not_of("eac") != std::string::npos || f.terms.empty())
+                throw std::invalid_argument("--terms takes letters from e, a, c; got '" + f.terms + "'");
+            return run_fit(f);
+        }
     } catch (const std::exception& e) {
         std::cerr << "latentpt: error: " << e.what() << "\n";
         return 1;

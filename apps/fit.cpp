@@ -1,0 +1,137 @@
+// `latentpt fit`: stage 1 of the paper's pipeline. Fits per-shape latent parameters to a target
+// latent map and writes params.json, the rendered latent (and its three terms), loss.csv,
+// pictures of target / render / difference, and checkpoints (--resume continues a killed fit).
+#include "apps/commands.h"
+#include "autodiff/fit.h"
+#include "autodiff/loss.h"
+#include "core/latent_viz.h"
+#include "core/scene_loader.h"
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+namespace lpt::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<float> load_target(const std::string& path, int& w, int& h) {
+    Image img = read_image(path);
+    if (img.channels != kLatentChannels)
+        throw std::runtime_error(path + ": target has " + std::to_string(img.channels) + " channels, a latent map needs " + std::to_string(kLatentChannels) +
+                                 " (an RGB image needs --encode, which arrives with the VAE)");
+    size_t bad = 0;
+    if (!check_finite(img.data.data(), img.data.size(), &bad))
+        throw std::runtime_error(path + ": value at pixel (" + std::to_string(bad / kLatentChannels % img.width) + ", " +
+                                 std::to_string(bad / kLatentChannels / img.width) + "), channel " + std::to_string(bad % kLatentChannels) +
+                                 " is not finite");
+    w = img.width;
+    h = img.height;
+    return img.data;
+}
+
+void write_latent(const std::string& path, int w, int h, const std::vector<float>& data) {
+    Image img{w, h, kLatentChannels, data, {}};
+    write_exr(path, img);
+}
+
+std::string loss_csv(const FitState& st) {
+    std::ostringstream out;
+    out << "iteration,loss,smoothed_loss,lr,seconds\n";
+    for (const FitRecord& r : st.history) out << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.lr << "," << r.seconds << "\n";
+    return out.str();
+}
+
+}  // namespace
+
+int run_fit(const FitArgs& a) {
+    Scene scene = load_scene(a.scene, a.defines);
+    LatentModel model(scene, parameterisation_from_string(a.param), a.seed);
+    model.terms().gate = a.gate == "visible" ? OcclusionGate::Visible : OcclusionGate::Shadowed;
+    model.terms().emission = a.terms.find('e') != std::string::npos;
+    model.terms().ambient = a.terms.find('a') != std::string::npos;
+    model.terms().occlusion = a.terms.find('c') != std::string::npos;
+
+    FitOptions o;
+    o.iterations = a.iterations;
+    o.spp = a.spp;
+    o.seed = a.seed;
+    o.lr = a.lr;
+    o.lr_min = a.lr_min;
+    o.lr_period = a.lr_period;
+    o.patience = a.patience;
+    o.min_delta = a.min_delta;
+    o.tone = parse_tone_curve(a.tone);
+    o.checkpoint_every = a.checkpoint_every;
+    o.checkpoint_dir = (fs::path(a.out) / "checkpoint").string();
+
+    int w = 0, h = 0;
+    std::vector<float> target;
+    if (!a.target.empty()) {
+        target = load_target(a.target, w, h);
+    } else {
+        // A target the latent renderer makes itself from random parameters: for trying the fit
+        // without a VAE, and the test suite's convergence check.
+        parse_resolution(a.synthetic_res, w, h);
+        Scene truth_scene = load_scene(a.scene, a.defines);
+        LatentModel truth(truth_scene, parameterisation_from_string(a.param), a.synthetic_seed);
+        RenderOptions ro = RenderOptions::from_scene(truth_scene);
+        ro.width = w;
+        ro.height = h;
+        ro.spp = a.final_spp;
+        ro.seed = a.synthetic_seed;
+        target = render_toned(truth, ro, o.tone);
+        write_latent((fs::path(a.out) / "target.exr").string(), w, h, target);
+    }
+
+    FitState state;
+    if (a.resume) {
+        state = load_checkpoint(o.checkpoint_dir, model);
+        if (!a.quiet) std::cerr << "resuming at iteration " << state.next_iteration << "\n";
+    }
+    const int start = state.next_iteration;
+    const double seconds_at_start = state.history.empty() ? 0.0 : state.history.back().seconds;
+    double last_print = -1.0;
+    auto on_iteration = [&](const FitRecord& r, const FitState&) {
+        if (a.quiet) return true;
+        const int done = r.iteration + 1 - start, total = std::max(1, o.iterations - start);
+        const double el = std::max(1e-9, r.seconds - seconds_at_start);
+        if (el - last_print < 0.25 && done < total) return true;  // a line every 0.25 s at most
+        last_print = el;
+        std::fprintf(stderr, "\r[fit] it %d/%d | loss %.5f (smoothed %.5f) | lr %.2e | %.1f it/s | ETA %.0f s   ", r.iteration + 1, o.iterations,
+                     r.loss, r.smoothed, r.lr, done / el, el * (total - done) / std::max(1, done));
+        return true;
+    };
+    state = fit_latent(model, target, w, h, o, state, on_iteration);
+    if (!a.quiet) std::fprintf(stderr, "\n[fit] best smoothed loss %.5f at iteration %d; %d refused steps\n", state.best_loss, state.best_iteration, state.skipped_steps);
+    save_checkpoint(o.checkpoint_dir, model, state);
+
+    // Final render of the best parameters at --final-spp.
+    RenderOptions ro = RenderOptions::from_scene(model.scene());
+    ro.width = w;
+    ro.height = h;
+    ro.spp = a.final_spp;
+    ro.seed = a.seed + 1;
+    TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro);
+    std::vector<float> linear = films.sum(), toned(linear.size()), diff(linear.size());
+    tone_map(o.tone, linear.data(), toned.data(), linear.size());
+    for (size_t i = 0; i < toned.size(); ++i) diff[i] = toned[i] - target[i];
+    const fs::path out(a.out);
+    write_text_atomic((out / "params.json").string(), model.params().to_json());
+    write_latent((out / "latent.exr").string(), w, h, toned);
+    write_latent((out / "latent_e.exr").string(), w, h, films.e.develop());
+    write_latent((out / "latent_a.exr").string(), w, h, films.a.develop());
+    write_latent((out / "latent_c.exr").string(), w, h, films.c.develop());
+    write_text_atomic((out / "loss.csv").string(), loss_csv(state));
+    float scale = 0.f;
+    for (float v : target) scale = std::max(scale, std::abs(v));
+    write_png_srgb((out / "target.png").string(), latent_grid(target.data(), w, h, kLatentChannels, scale));
+    write_png_srgb((out / "render.png").string(), latent_grid(toned.data(), w, h, kLatentChannels, scale));
+    write_png_srgb((out / "diff.png").string(), latent_grid(diff.data(), w, h, kLatentChannels, scale));
+    double final_loss = huber_loss(toned.data(), target.data(), toned.size(), 1.f, nullptr);
+    if (!a.quiet) std::cerr << "wrote " << a.out << "/{params.json, latent*.exr, loss.csv, target|render|diff.png}; Huber loss at " << a.final_spp << " spp: " << final_loss << "\n";
+    return 0;
+}
+
+}  // namespace lpt::app

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# End-to-end checks of the latentpt command line: outputs exist, --resume continues, bad input
+# fails with a message naming the file and a non-zero exit code (never a crash).
+set -u
+bin="$1"; src="$2"
+out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
+fail=0; passed=0
+check() { if "$@"; then passed=$((passed + 1)); else echo "FAILED: $*"; fail=$((fail + 1)); fi; }
+expect_error() {  # expect_error NEEDLE cmd...: a non-zero exit that is not a signal, NEEDLE in stderr
+    local needle="$1"; shift
+    "$@" 2>"$out/err.txt" >/dev/null; local rc=$?
+    if [ $rc -eq 0 ] || [ $rc -ge 128 ] || ! grep -q -- "$needle" "$out/err.txt"; then
+        echo "FAILED: expected an error exit and '$needle' from: $* (rc=$rc)"; cat "$out/err.txt"; fail=$((fail + 1))
+    else passed=$((passed + 1)); fi
+}
+scene="$src/scenes/cornell-box/scene.json"
+
+"$bin" render "$scene" --spp 2 --res 24x16 --aov --aov-res 6x4 -q --out "$out/r.exr"
+check test -s "$out/r.exr"; check test -s "$out/r.png"; check test -s "$out/r.normal.exr"
+"$bin" fit "$scene" --synthetic-res 8x8 --iterations 20 --spp 2 --final-spp 4 --checkpoint-every 10 -q -D integrator.max_depth=3 --out "$out/fit"
+for f in params.json latent.exr latent_e.exr latent_a.exr latent_c.exr loss.csv target.png render.png diff.png checkpoint/state.json; do
+    check test -s "$out/fit/$f"
+done
+check test "$(wc -l < "$out/fit/loss.csv")" -eq 21
+"$bin" fit "$scene" --synthetic-res 8x8 --iterations 30 --spp 2 --final-spp 4 -q -D integrator.max_depth=3 --out "$out/fit" --resume
+check test "$(wc -l < "$out/fit/loss.csv")" -eq 31
+
+expect_error "channels" "$bin" fit "$scene" --target "$out/r.exr" -q --out "$out/bad"
+expect_error "does not exist" "$bin" render "$out/missing.json" -q --out "$out/x.exr"
+printf '{"camera": {"fov": 40}, "shapes": [ {"type": "obj", "filename": "nope.obj", "material": "m"} ], "materials": {"m": {"type": "diffuse"}}}' > "$out/s.json"
+expect_error "nope.obj" "$bin" render "$out/s.json" -q --out "$out/x.exr"
+expect_error "WxH" "$bin" render "$scene" --res 12 -q --out "$out/x.exr"
+expect_error "--terms" "$bin" fit "$scene" --terms xyz -q --out "$out/bad"
+expect_error "checkpoint" "$bin" fit "$scene" --resume -q --out "$out/never-fitted"
+
+echo "$passed passed, $fail failed"
+[ $fail -eq 0 ]
