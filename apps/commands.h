@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace lpt::app {
 
@@ -29,8 +30,13 @@ struct BenchArgs {
     int res = 256;
     int sphere_triangles = 100000;
     std::string out_json;         ///< optional machine-readable results
+    bool fit = false;             ///< time fit iterations (forward / adjoint) instead of rays/s
+    std::string fit_scene;        ///< default: ../shared/scenes/cbox/cbox_specular.xml, else ours
+    int fit_res = 128;
+    std::vector<int> fit_spp{16, 64, 256};
 };
 int run_bench(const BenchArgs& args);
+int run_bench_fit(const BenchArgs& args);
 
 struct FitArgs {
     std::string scene, target, out = "fit-out";

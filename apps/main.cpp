@@ -36,6 +36,10 @@ int main(int argc, char** argv) {
     bench->add_option("--res", b.res, "square resolution")->capture_default_str();
     bench->add_option("--sphere-triangles", b.sphere_triangles, "triangles of the sphere added for the heavy-scene run")->capture_default_str();
     bench->add_option("--json", b.out_json, "also write the results as JSON");
+    bench->add_flag("--fit", b.fit, "time fit iterations (forward and adjoint) at latent resolution instead");
+    bench->add_option("--fit-scene", b.fit_scene, "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)");
+    bench->add_option("--fit-res", b.fit_res, "latent resolution for --fit")->capture_default_str();
+    bench->add_option("--fit-spp", b.fit_spp, "samples per pixel per iteration for --fit")->capture_default_str();
 
     FitArgs f;
     std::vector<std::string> fit_defines;
@@ -76,7 +80,7 @@ int main(int argc, char** argv) {
             }
             return run_render(r);
         }
-        if (*bench) return run_bench(b);
+        if (*bench) return b.fit ? run_bench_fit(b) : run_bench(b);
         if (*fit) {
             for (const auto& d : fit_defines) {
                 auto eq = d.find('=');
