@@ -72,9 +72,9 @@ public:
     }
 
     /// ∂(f·|cos wo|)/∂c for the coefficient c = spectral_keys()[key], per channel, over the
-    /// non-delta lobes. f is affine in each coefficient, so this does not depend on c itself;
-    /// no division by f anywhere (docs/path-replay.md). Plugins without an analytic derivative
-    /// yet throw std::logic_error naming themselves.
+    /// non-delta lobes. f is affine in each coefficient except the diffuse colour of plastics
+    /// with nonlinear = true (then this depends on c); no division by f anywhere
+    /// (docs/path-replay.md). The base class throws std::logic_error.
     virtual Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const {
         throw std::logic_error("this BSDF type has no coefficient gradients yet");
     }

@@ -10,7 +10,9 @@
 // (Mitsuba also weighs by mean reflectances, which are signed in latent space); the diffuse
 // Fresnel reflectance is integrated numerically instead of Mitsuba's polynomial fits (they
 // differ by < 0.2% for 1.2 <= IOR <= 2), which makes a white plastic conserve energy exactly.
-// Equations: docs/bsdfs.md (1), (4), (22)-(24).
+// Gradients w.r.t. diffuse_reflectance (key 0) and specular_reflectance (key 1): docs/bsdfs.md
+// (34)-(35); with nonlinear = true the base colour is not affine in diffuse_reflectance.
+// Equations: docs/bsdfs.md (1), (4), (22)-(24), (34)-(35).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/warp.h"
@@ -77,14 +79,42 @@ public:
     uint32_t flags() const override { return kDeltaReflection | kDiffuseReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_diffuse; }
 
+    /// ∂(f·|cos wo|)/∂c over the diffuse lobe, docs/bsdfs.md (35). Key 0 (diffuse_reflectance):
+    /// (23) with ρ̃ replaced by ∂ρ̃/∂ρ from (34), which is a constant for nonlinear = false but
+    /// 1/(1 − ρ Fdr)² for nonlinear = true, so there it depends on the current diffuse
+    /// reflectance (the gradient at the present coefficients, not a global constant). Key 1
+    /// (specular_reflectance): 0, the specular lobe is delta and not part of eval.
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        if (key != 0 || cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
+        float t_i = 1.f - fresnel_dielectric(cos_theta(wi), m_eta).R;
+        float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
+        return m_base_grad * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));
+    }
+    /// ∂(bs.weight)/∂c, docs/bsdfs.md (35): the delta sample's weight is specular_reflectance
+    /// (22), so 1 for key 1 and 0 for key 0; the diffuse sample's closed-form weight ρ̃ (1 − R_o)/η²
+    /// (24) gives ∂ρ̃/∂ρ (1 − R_o)/η² for key 0 (current-ρ dependent when nonlinear) and 0 for key 1.
+    Spectrum<N> weight_grad(const BSDFContext&, const Vec3f&, const BSDFSample<N>& bs, int key) const override {
+        if (bs.lobe == kDeltaReflection) return Spectrum<N>::Constant(key == 1 ? 1.f : 0.f);
+        if (key != 0) return Spectrum<N>::Zero();
+        float t_o = 1.f - fresnel_dielectric(cos_theta(bs.wo), m_eta).R;
+        return m_base_grad * (m_inv_eta2 * t_o);
+    }
+
 private:
+    // ρ̃ and ∂ρ̃/∂ρ, docs/bsdfs.md (23), (34).
     void update_base() {
-        m_base = m_nonlinear ? Spectrum<N>(m_diffuse / (1.f - m_diffuse * m_fdr_int))
-                             : Spectrum<N>(m_diffuse / (1.f - m_fdr_int));
+        if (m_nonlinear) {
+            Spectrum<N> denom = 1.f - m_diffuse * m_fdr_int;
+            m_base = m_diffuse / denom;
+            m_base_grad = 1.f / (denom * denom);
+        } else {
+            m_base = m_diffuse / (1.f - m_fdr_int);
+            m_base_grad = Spectrum<N>::Constant(1.f / (1.f - m_fdr_int));
+        }
     }
 
     float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f;
-    Spectrum<N> m_diffuse, m_specular, m_base;
+    Spectrum<N> m_diffuse, m_specular, m_base, m_base_grad;
     bool m_nonlinear;
 };
 

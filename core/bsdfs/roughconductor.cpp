@@ -5,7 +5,8 @@
 // neither eta nor k (or material "none") is a perfect F = 1 conductor. That is also what
 // Mitsuba 3's code does (material defaults to "none" → eta 0, k 1), although Mitsuba's docs and
 // Mitsuba 0.6 name copper as the default; copper needs an IOR database, which we do not ship.
-// Equations: docs/bsdfs.md (10), (12), (15)-(16).
+// Gradients: ∂/∂specular_reflectance of eval and of the sample weight, docs/bsdfs.md (30)-(31).
+// Equations: docs/bsdfs.md (10), (12), (15)-(16), (30)-(31).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/microfacet.h"
@@ -53,6 +54,23 @@ public:
 
     uint32_t flags() const override { return kGlossyReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_specular * m_ior.fresnel(1.f); }
+
+    /// ∂(f·|cos wo|)/∂specular_reflectance = F(wi·h) D G / (4 cos θi), docs/bsdfs.md (30): eval
+    /// with the colour replaced by ones (same zero cases), independent of the colour.
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int) const override {
+        if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
+        Vec3f h = (wi + wo).normalized();
+        float value = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_theta(wi));
+        if (value == 0.f) return Spectrum<N>::Zero();
+        return m_ior.fresnel(wi.dot(h)) * value;
+    }
+    /// ∂(bs.weight)/∂specular_reflectance = F(wi·m) w(12), docs/bsdfs.md (31): the derivative of
+    /// the closed form sample() uses (equal to eval_grad/pdf only up to rounding), with the
+    /// microfacet normal m recovered as the reflection half vector of (wi, bs.wo).
+    Spectrum<N> weight_grad(const BSDFContext&, const Vec3f& wi, const BSDFSample<N>& bs, int) const override {
+        Vec3f m = (wi + bs.wo).normalized();
+        return m_ior.fresnel(wi.dot(m)) * m_distr.sample_weight(wi, bs.wo, m);
+    }
 
     std::vector<std::string> spectral_keys() const override { return {"specular_reflectance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {

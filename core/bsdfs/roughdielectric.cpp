@@ -6,7 +6,8 @@
 // int_ior (default 1.5046 = BK7), ext_ior (default 1.000277 = air), > 0 and distinct;
 // specular_reflectance, specular_transmittance (rgb, default 1).
 // Transmitted radiance is scaled by 1/eta^2 in TransportMode::Radiance only.
-// Equations: docs/bsdfs.md (1)-(2), (7)-(12), (18)-(21).
+// Gradients w.r.t. the two colours (keys 0 and 1): docs/bsdfs.md (32)-(33).
+// Equations: docs/bsdfs.md (1)-(2), (7)-(12), (18)-(21), (32)-(33).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/microfacet.h"
@@ -92,6 +93,37 @@ public:
 
     uint32_t flags() const override { return kGlossyReflection | kGlossyTransmission; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_transmittance; }
+
+    /// ∂(f·|cos wo|)/∂colour, docs/bsdfs.md (32): key 0 (specular_reflectance) is (19) without
+    /// the colour on reflection pairs and 0 on transmission pairs; key 1 (specular_transmittance)
+    /// is (20) without the colour on transmission pairs and 0 on reflection pairs. Independent
+    /// of both colours.
+    Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        Half h;
+        if (!half_vector(wi, wo, h)) return Spectrum<N>::Zero();
+        if (h.reflect != (key == 0)) return Spectrum<N>::Zero();  // the other colour's lobe
+        float D = m_distr.D(h.m);
+        if (D == 0.f) return Spectrum<N>::Zero();
+        float F = fresnel(h);
+        float G = m_distr.G(wi, wo, h.m);
+        float cos_i = cos_theta(wi);
+        if (h.reflect) return Spectrum<N>::Constant(F * D * G / (4.f * std::abs(cos_i)));
+        float denom = h.wi_m + h.eta * h.wo_m;
+        float value = std::abs((1.f - F) * D * G * h.eta * h.eta * h.wi_m * h.wo_m / (cos_i * denom * denom));
+        return Spectrum<N>::Constant(value * radiance_scale(ctx, h.eta));
+    }
+    /// ∂(bs.weight)/∂colour, docs/bsdfs.md (33): sample() returns colour · w(12) (· s(18) for
+    /// refraction) in closed form, so this is w (· s) for the sampled lobe's colour and 0 for the
+    /// other, with m recovered as the generalised half vector of (wi, bs.wo) (bs.eta = η_it).
+    Spectrum<N> weight_grad(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const override {
+        bool reflect_lobe = bs.lobe == kGlossyReflection;
+        if (reflect_lobe != (key == 0)) return Spectrum<N>::Zero();
+        Half h;
+        half_vector(wi, bs.wo, h);  // h.m is set for any valid sample; the side checks do not matter here
+        bool up = cos_theta(wi) > 0.f;
+        float w = m_distr.sample_weight(up ? wi : Vec3f(-wi), up ? bs.wo : Vec3f(-bs.wo), h.m);
+        return Spectrum<N>::Constant(reflect_lobe ? w : w * radiance_scale(ctx, bs.eta));
+    }
 
     std::vector<std::string> spectral_keys() const override { return {"specular_reflectance", "specular_transmittance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {

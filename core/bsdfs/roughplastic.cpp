@@ -12,7 +12,9 @@
 // applied to the rough table (Mitsuba integrates the internal rough reflectance separately),
 // which makes a white roughplastic conserve energy up to the table's accuracy (~1e-3): the
 // base receives exactly what the rough coating does not reflect.
-// Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28).
+// Gradients w.r.t. diffuse_reflectance (key 0) and specular_reflectance (key 1): docs/bsdfs.md
+// (34), (36); with nonlinear = true the base colour is not affine in diffuse_reflectance.
+// Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28), (34), (36).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/microfacet.h"
@@ -94,10 +96,34 @@ public:
     uint32_t flags() const override { return kGlossyReflection | kDiffuseReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_diffuse; }
 
+    /// ∂(f·|cos wo|)/∂c, docs/bsdfs.md (36). Key 0 (diffuse_reflectance): the diffuse term of
+    /// (25) with ρ̃ replaced by ∂ρ̃/∂ρ from (34): a constant for nonlinear = false, but
+    /// 1/(1 − ρ Fdr_int)² for nonlinear = true, so there it depends on the current diffuse
+    /// reflectance. Key 1 (specular_reflectance): the specular term of (25) without the colour.
+    /// weight_grad keeps the base-class default: sample() returns exactly eval/pdf (28) with a
+    /// coefficient-independent pdf, so ∂weight/∂c = eval_grad/pdf.
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
+        if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
+        if (key == 0)
+            return m_base_grad * (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
+        Vec3f h = (wi + wo).normalized();
+        float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);
+        if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
+        return Spectrum<N>::Constant(spec);
+    }
+
 private:
+    // ρ̃ and ∂ρ̃/∂ρ, docs/bsdfs.md (25), (34).
     void update_base() {
-        m_base = m_nonlinear ? Spectrum<N>(m_diffuse / (1.f - m_diffuse * m_fdr_int))
-                             : Spectrum<N>(m_diffuse / (1.f - m_fdr_int));
+        if (m_nonlinear) {
+            Spectrum<N> denom = 1.f - m_diffuse * m_fdr_int;
+            m_base = m_diffuse / denom;
+            m_base_grad = 1.f / (denom * denom);
+        } else {
+            m_base = m_diffuse / (1.f - m_fdr_int);
+            m_base_grad = Spectrum<N>::Constant(1.f / (1.f - m_fdr_int));
+        }
     }
 
     // t(mu) by linear interpolation over mu = j / (kTableRes - 1), as Mitsuba's lerp_gather.
@@ -140,7 +166,7 @@ private:
     MicrofacetDistribution m_distr;
     float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f;
     bool m_nonlinear = false;
-    Spectrum<N> m_diffuse, m_specular, m_base;
+    Spectrum<N> m_diffuse, m_specular, m_base, m_base_grad;
     std::array<float, kTableRes> m_table{};
 };
 
