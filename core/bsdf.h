@@ -84,6 +84,24 @@ public:
         return eval_grad(ctx, wi, bs.wo, key) / bs.pdf;
     }
 
+    /// Scalar parameters exposed to fitting (rough BSDFs: {"alpha"}). Sampling depends on them,
+    /// but path replay treats sampled directions and pdfs as constants (docs/path-replay.md).
+    virtual std::vector<std::string> scalar_keys() const { return {}; }
+    virtual float get_scalar(const std::string& key) const {
+        throw std::invalid_argument("BSDF has no scalar parameter '" + key + "'");
+    }
+    virtual void set_scalar(const std::string& key, float value) {
+        throw std::invalid_argument("BSDF has no scalar parameter '" + key + "'");
+    }
+    /// ∂(f·|cos wo|)/∂s for s = scalar_keys()[key], per channel, non-delta lobes.
+    virtual Spectrum<N> eval_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const {
+        throw std::logic_error("this BSDF type has no scalar-parameter gradients");
+    }
+    /// ∂(bs.weight)/∂s with the sampled direction and its pdf held fixed: (∂f/∂s)/pdf by default.
+    virtual Spectrum<N> weight_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const {
+        return eval_grad_scalar(ctx, wi, bs.wo, key) / bs.pdf;
+    }
+
     bool has_delta() const { return (flags() & kDelta) != 0; }
     bool is_delta() const { return (flags() & kNonDelta) == 0; }
 };
