@@ -1,5 +1,6 @@
 #include "autodiff/latent_model.h"
 #include "core/sampler.h"
+#include <algorithm>
 #include <stdexcept>
 
 namespace lpt {
@@ -55,6 +56,8 @@ LatentModel::LatentModel(Scene& scene, Parameterisation p, uint64_t seed) : m_sc
             sl.Lc = add(shape.id + ".Lc", "Lc", false);
         }
         for (const std::string& key : bsdf.spectral_keys()) sl.bsdf.emplace_back(key, add(shape.id + ".bsdf." + key, "reflectance", true));
+        for (const std::string& key : bsdf.scalar_keys())
+            sl.scalar.emplace_back(key, m_params.add(shape.id + ".bsdf." + key, key, ParamMap::Sigmoid, 1, -1e30f, 1e30f));
     }
     if (m_scene.environment >= 0) m_env_slot = add("environment.Le", "Le", false);
     m_background = add("background", "background", false);
@@ -64,6 +67,13 @@ LatentModel::LatentModel(Scene& scene, Parameterisation p, uint64_t seed) : m_sc
     uint64_t k = 0;
     for (const char* kind : {"Le", "La", "Lc", "background"}) m_params.init_uniform(kind, radiance.init_a, radiance.init_b, mix64(seed + ++k));
     m_params.init_uniform("reflectance", refl.init_a, refl.init_b, mix64(seed + ++k));
+
+    // Scalars (roughness) start where the scene file puts them, inside the sigmoid's range.
+    for (size_t i = 0; i < m_scene.shapes.size(); ++i)
+        for (const auto& [key, slice] : m_slots[i].scalar) {
+            float v = std::clamp(m_spectra.bsdfs[m_scene.shapes[i].material]->get_scalar(key), 1e-3f, 0.999f);
+            m_params.set_value(slice, &v);
+        }
 
     m_terms.La.assign(m_scene.shapes.size(), Latent::Zero());
     m_terms.Lc.assign(m_scene.shapes.size(), Latent::Zero());
@@ -80,6 +90,7 @@ void LatentModel::sync() {
         m_terms.La[i] = sl.La >= 0 ? Latent(vec(sl.La)) : Latent::Zero();
         m_terms.Lc[i] = sl.Lc >= 0 ? Latent(vec(sl.Lc)) : Latent::Zero();
         for (const auto& [key, slice] : sl.bsdf) m_spectra.bsdfs[shape.material]->set_spectral(key, vec(slice));
+        for (const auto& [key, slice] : sl.scalar) m_spectra.bsdfs[shape.material]->set_scalar(key, *m_params.value(slice));
     }
     if (m_env_slot >= 0) m_spectra.radiance[m_scene.environment] = vec(m_env_slot);
     m_terms.background = vec(m_background);

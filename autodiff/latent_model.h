@@ -19,7 +19,8 @@ using Latent = Spectrum<kLatentChannels>;
 
 /// Paper: signed values as pos − neg parts clipped to [0, hi], init U[0, 1] (reflectance parts
 /// in [0, 1]). Code (public implementation): reflectance = sigmoid(raw), init raw U[−1, 1];
-/// radiance-like vectors raw in [−6, 6], init U[−0.1, 0.1].
+/// radiance-like vectors raw in [−6, 6], init U[−0.1, 0.1]. Roughness alpha is not a signed
+/// vector: sigmoid in both, initialised at the scene file's value.
 enum class Parameterisation { Paper, Code };
 Parameterisation parameterisation_from_string(const std::string& s);  ///< "paper" | "code"
 
@@ -32,6 +33,7 @@ public:
     struct ShapeSlots {
         int Le = -1, La = -1, Lc = -1;
         std::vector<std::pair<std::string, int>> bsdf;  ///< (coefficient key, slice)
+        std::vector<std::pair<std::string, int>> scalar; ///< (scalar key, 1-channel slice), e.g. alpha
     };
 
     /// Writes ParamStore values into spectra and terms (call after every optimiser step).

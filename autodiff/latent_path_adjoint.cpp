@@ -22,6 +22,7 @@ struct Event {
     L beta = L::Zero();  ///< throughput in front of this vertex
     L local = L::Zero(); ///< Bounce: weight / q; Light: ∂value/∂L̃e coefficient f · w / pdf
     L grad[kMaxKeys] = {L::Zero(), L::Zero()};  ///< Light: ∂f/∂c_k · w/pdf; Bounce: ∂weight/∂c_k / q
+    L sgrad = L::Zero();  ///< the same for the BSDF's scalar parameter (roughness), if any
 };
 
 struct PathEvents {
@@ -73,6 +74,7 @@ public:
             e.local = bsdf.eval(ctx, wi, wo) * w_over_pdf;
             const auto& keys = m_model.slots(shape).bsdf;
             for (size_t k = 0; k < keys.size() && k < kMaxKeys; ++k) e.grad[k] = bsdf.eval_grad(ctx, wi, wo, int(k)) * w_over_pdf;
+            if (!m_model.slots(shape).scalar.empty()) e.sgrad = bsdf.eval_grad_scalar(ctx, wi, wo, 0) * w_over_pdf;
         }
         Scratch& s = m_scratch.local();
         if (shadow_id >= 0) {
@@ -97,6 +99,7 @@ public:
         const BSDF<kLatentChannels>& bsdf = m_model.spectra().bsdf_of(m_model.scene(), shape);
         const auto& keys = m_model.slots(shape).bsdf;
         for (size_t k = 0; k < keys.size() && k < kMaxKeys; ++k) e.grad[k] = bsdf.weight_grad(ctx, wi, bs, int(k)) / q;
+        if (!m_model.slots(shape).scalar.empty() && !(bs.lobe & kDelta)) e.sgrad = bsdf.weight_grad_scalar(ctx, wi, bs, 0) / q;
         push(slot, e);
     }
 
@@ -114,6 +117,11 @@ public:
             auto add = [&](int slice, const L& v) {
                 if (slice < 0) return;
                 Eigen::Map<L>(g.data() + ps.slice(slice).value_offset) += v;
+            };
+            // A scalar parameter (roughness) scales every channel: its derivative sums them.
+            auto add_scalar = [&](int shape, const L& v) {
+                const auto& sc = m_model.slots(shape).scalar;
+                if (!sc.empty()) g[ps.slice(sc[0].second).value_offset] += v.sum();
             };
             L R = L::Zero();
             for (size_t i = ev.size(); i-- > 0;) {
@@ -142,12 +150,14 @@ public:
                             add(emitter_slice(e.emitter), d * e.beta * e.local);
                             const auto& keys = m_model.slots(e.shape).bsdf;
                             for (size_t k = 0; k < keys.size() && k < kMaxKeys; ++k) add(keys[k].second, d * e.beta * e.grad[k] * le);
+                            add_scalar(e.shape, d * e.beta * e.sgrad * le);
                         }
                         break;
                     }
                     case Event::Bounce: {
                         const auto& keys = m_model.slots(e.shape).bsdf;
                         for (size_t k = 0; k < keys.size() && k < kMaxKeys; ++k) add(keys[k].second, d * e.beta * e.grad[k] * R);
+                        add_scalar(e.shape, d * e.beta * e.sgrad * R);
                         R = e.local * R;
                         break;
                     }
