@@ -93,7 +93,10 @@ int run_fit(const FitArgs& a) {
     const int start = state.next_iteration;
     const double seconds_at_start = state.history.empty() ? 0.0 : state.history.back().seconds;
     double last_print = -1.0;
-    auto on_iteration = [&](const FitRecord& r, const FitState&) {
+    auto on_iteration = [&](const FitRecord& r, const FitState& st) {
+        if (r.refused && st.skipped_steps <= 10)
+            std::fprintf(stderr, "\nlatentpt: warning: iteration %d: non-finite gradient, step skipped (%d so far)%s\n", r.iteration, st.skipped_steps,
+                         st.skipped_steps == 10 ? "; further warnings suppressed" : "");
         if (a.quiet) return true;
         const int done = r.iteration + 1 - start, total = std::max(1, o.iterations - start);
         const double el = std::max(1e-9, r.seconds - seconds_at_start);

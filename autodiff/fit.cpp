@@ -87,7 +87,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         state.next_iteration = it + 1;
         state.adam = adam.state();
         double secs = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        FitRecord rec{it, loss, state.smoothed, lr, secs};
+        FitRecord rec{it, loss, state.smoothed, lr, secs, bad != 0};
         state.history.push_back(rec);
         if (o.checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % o.checkpoint_every == 0) save_checkpoint(o.checkpoint_dir, model, state);
         if (on_iteration && !on_iteration(rec, state)) break;

@@ -32,6 +32,7 @@ struct FitRecord {
     double loss, smoothed;
     float lr;
     double seconds;
+    bool refused = false;  ///< the gradient had NaN/Inf entries: the step was skipped
 };
 
 struct FitState {
