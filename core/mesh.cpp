@@ -94,11 +94,11 @@ void validate_mesh(TriangleMesh& mesh, const std::string& file, const std::strin
                                        : "mesh has no triangles");
 }
 
-TriangleMesh load_mesh_file(const std::string& path, bool flip_v) {
+TriangleMesh load_mesh_file(const std::string& path, bool flip_v, bool drop_degenerate) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
     // flip_v is an OBJ convention (Mitsuba's flip_tex_coords); PLY and glTF uvs are taken as stored.
-    if (ext == ".obj") return load_obj(path, flip_v);
+    if (ext == ".obj") return load_obj(path, flip_v, drop_degenerate);
     if (ext == ".ply") return load_ply(path);
     if (ext == ".gltf" || ext == ".glb") return load_gltf(path);
     throw SceneError(path, "", "unknown mesh file extension '" + ext + "' (expected .obj, .ply, .gltf or .glb)");

@@ -27,14 +27,17 @@ void validate_mesh(TriangleMesh& mesh, const std::string& file, const std::strin
 /// Readers. Each throws SceneError naming `path` on missing file / parse error; they validate.
 /// OBJ: v, vt, vn, faces with v, v/vt, v//vn, v/vt/vn; polygons fan-triangulated. Mitsuba
 /// flips the v texture coordinate on load (`flip_tex_coords`): pass flip_v=true for its scenes.
-TriangleMesh load_obj(const std::string& path, bool flip_v = false);
+/// drop_degenerate: remove zero-area triangles instead of failing (validate_mesh), as Mitsuba
+/// does; the Mitsuba XML loader passes true, our JSON format keeps rejecting them.
+TriangleMesh load_obj(const std::string& path, bool flip_v = false, bool drop_degenerate = false);
 /// PLY, ascii and binary (little/big endian): vertex x y z [nx ny nz] [u v | s t | texture_u ...],
 /// face vertex_indices / vertex_index lists (polygons fan-triangulated).
 TriangleMesh load_ply(const std::string& path);
 /// glTF 2.0 (.gltf / .glb): all triangle primitives of all meshes, node transforms applied.
 TriangleMesh load_gltf(const std::string& path);
-/// Dispatch on extension (.obj, .ply, .gltf, .glb).
-TriangleMesh load_mesh_file(const std::string& path, bool flip_v = false);
+/// Dispatch on extension (.obj, .ply, .gltf, .glb). flip_v and drop_degenerate reach the OBJ
+/// reader only: PLY and glTF uvs are taken as stored and those readers always validate strictly.
+TriangleMesh load_mesh_file(const std::string& path, bool flip_v = false, bool drop_degenerate = false);
 
 /// Analytic shapes, tessellated in object space (Mitsuba's canonical forms).
 TriangleMesh make_rectangle();                 ///< [-1,1]^2 at z=0, normal +z, uv in [0,1]^2

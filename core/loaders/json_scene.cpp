@@ -3,6 +3,7 @@
 #include "core/bsdf.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "core/texture.h"
 #include <nlohmann/json.hpp>
 #include <filesystem>
 #include <fstream>
@@ -85,7 +86,9 @@ struct Ctx {
         return t;
     }
 
-    /// Plugin description: numbers → float, 3-arrays → rgb, objects → nested Props.
+    /// Plugin description: numbers → float, 3-arrays → rgb, objects → nested Props. A nested
+    /// {"type": "bitmap", "filename": ...} gets its filename resolved against the scene's folder
+    /// here, so the Props stand on their own (core/texture.h reads them).
     Props props(const json& j, const std::string& field) const {
         if (!j.is_object()) fail(field, "expected an object");
         Props p;
@@ -103,6 +106,10 @@ struct Ctx {
             else if (v.is_object()) p.values[k] = std::make_shared<Props>(props(v, f));
             else fail(f, "unsupported value");
         }
+        if (p.type == "bitmap")
+            if (auto it = p.values.find("filename"); it != p.values.end())
+                if (auto* name = std::get_if<std::string>(&it->second); name && !name->empty())
+                    *name = fs::absolute(dir / *name).lexically_normal().string();
         return p;
     }
 };
@@ -308,7 +315,14 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
         }
     }
     // Validate every material once, now, so errors point at the file before rendering starts.
-    for (const Props& m : scene.materials) make_bsdf<3>(m);
+    // A bitmap under a key its BSDF reads as a plain colour gets a message saying so.
+    for (const Props& m : scene.materials) {
+        try {
+            make_bsdf<3>(m);
+        } catch (const SceneError& e) {
+            throw explain_texture_error(m, e);
+        }
+    }
     scene.build();
     return scene;
 }

@@ -5,6 +5,7 @@
 #include "core/bsdf.h"
 #include "core/loaders/mitsuba_xml_detail.h"
 #include "core/scene_loader.h"
+#include "core/texture.h"
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -33,8 +34,8 @@ struct Plugin {
 struct IdEntry {
     std::string tag;
     int line = -1;
-    std::shared_ptr<Props> bsdf;  ///< for <bsdf>
-    int material = -1;            ///< index in Scene::materials once a shape uses it
+    std::shared_ptr<Props> props;  ///< for <bsdf> and <texture>
+    int material = -1;             ///< index in Scene::materials once a shape uses it
 };
 
 /// The error `e` (thrown by a plugin factory for this file) again, with the XML line added.
@@ -59,9 +60,9 @@ public:
             else if (tag == "bsdf") read_bsdf(c, "bsdf");
             else if (tag == "shape") read_shape(c);
             else if (tag == "emitter") read_top_emitter(c);
-            else if (tag == "texture") fail_texture(c);
+            else if (tag == "texture") read_top_texture(c);
             else if (tag == "medium") skip_medium(c);
-            else src.fail(c, "", "<" + tag + "> is not supported at the top level of <scene> (known: default, integrator, sensor, bsdf, shape, emitter)");
+            else src.fail(c, "", "<" + tag + "> is not supported at the top level of <scene> (known: default, integrator, sensor, bsdf, texture, shape, emitter)");
         }
         if (!have_sensor) src.fail(root, "sensor", "scene has no <sensor>");
         if (scene.shapes.empty()) src.fail(root, "shape", "scene has no <shape>");
@@ -100,9 +101,9 @@ private:
         return p;
     }
 
-    void register_id(const std::string& id, const std::string& tag, int line, std::shared_ptr<Props> bsdf = nullptr) {
+    void register_id(const std::string& id, const std::string& tag, int line, std::shared_ptr<Props> props = nullptr) {
         if (id.empty()) return;
-        auto [it, fresh] = ids.emplace(id, IdEntry{tag, line, std::move(bsdf), -1});
+        auto [it, fresh] = ids.emplace(id, IdEntry{tag, line, std::move(props), -1});
         if (!fresh) src.fail_at(line, "", "duplicate id '" + id + "' (first used by the <" + it->second.tag + "> at line " + std::to_string(it->second.line) + ")");
     }
     IdEntry& resolve_ref(const pugi::xml_node& ref) {
@@ -168,15 +169,56 @@ private:
     [[noreturn]] void unexpected_child(const Plugin& p, const pugi::xml_node& c) const {
         src.fail(c, p.where, "unexpected <" + std::string(c.name()) + "> inside <" + p.tag + " type=\"" + p.type + "\">");
     }
-    [[noreturn]] void fail_texture(const pugi::xml_node& n) const {
-        std::string type = n.attribute("type").value(), name = n.attribute("name").value();
-        std::string what = name.empty() ? "texture" : "texture for '" + name + "'";
-        if (type == "bitmap") src.fail(n, name, "textured parameters are not supported yet (<texture type=\"bitmap\"> as " + what + ")");
-        src.fail(n, name, "unknown texture plugin '" + type + "'; textured parameters are not supported yet");
+    /// A <texture> where only BSDFs take one (shapes, emitters).
+    [[noreturn]] void fail_texture(const Plugin& p, const pugi::xml_node& n) const {
+        std::string name = n.attribute("name").value();
+        src.fail(n, p.where + "." + name, "textured '" + name + "' on <" + p.tag + " type=\"" + p.type +
+                                              "\"> is not supported yet (bitmap textures work as BSDF parameters)");
     }
     void skip_medium(const pugi::xml_node& n) {
         // Media are ignored (none of our scenes needs one); keep the id so refs to it resolve.
         register_id(n.attribute("id").value(), "medium", src.line(n));
+    }
+
+    /// A <texture> as Props (type "bitmap"; filename made absolute, relative to the XML's folder
+    /// as Mitsuba resolves it). The image is loaded here, so a missing or unreadable file is
+    /// reported at this element's line; the BSDF later gets it from the cache.
+    std::shared_ptr<Props> read_texture(const pugi::xml_node& n, const std::string& what) {
+        Plugin p = read_plugin(n, what);
+        if (p.type != "bitmap") src.fail_at(p.line, p.where + ".type", "unknown texture plugin '" + p.type + "' (known: bitmap)");
+        if (p.find("to_uv")) fail_value(p, "to_uv", "to_uv is not supported yet (uvs are used as they are)");
+        allow_only(p, {"filename", "raw", "filter_type", "wrap_mode"});
+        for (const pugi::xml_node& c : p.children) unexpected_child(p, c);
+        if (!p.find("filename")) src.fail_at(p.line, p.where + ".filename", "a bitmap texture needs a filename");
+        std::string filter = get_string(p, "filter_type", "bilinear"), wrap = get_string(p, "wrap_mode", "repeat");
+        if (filter != "bilinear" && filter != "nearest") fail_value(p, "filter_type", "expected bilinear or nearest, got '" + filter + "'");
+        if (wrap != "repeat" && wrap != "mirror" && wrap != "clamp") fail_value(p, "wrap_mode", "expected repeat, mirror or clamp, got '" + wrap + "'");
+        const bool raw = get_bool(p, "raw", false);
+        std::string file = fs::absolute(dir / get_string(p, "filename", "")).lexically_normal().string();
+        try {
+            Texture::load_bitmap(file, raw);
+        } catch (const SceneError& e) {
+            fail_value(p, "filename", e.what());
+        }
+        auto props = std::make_shared<Props>(to_props(p));
+        props->values["filename"] = file;
+        return props;
+    }
+    /// Top-level <texture id>, for <ref name="reflectance" id="..."/> inside BSDFs (Mitsuba's
+    /// named textures).
+    void read_top_texture(const pugi::xml_node& n) {
+        auto props = read_texture(n, "texture");
+        std::string id = n.attribute("id").value();
+        if (id.empty()) src.fail(n, "texture", "a top-level <texture> needs an id (use it with <ref name=\"...\" id=\"...\"/> in a BSDF)");
+        register_id(id, "texture", src.line(n), props);
+    }
+    /// Puts a texture under `name` in a BSDF's props; a name given twice is an error, as for
+    /// properties.
+    void add_texture(const Plugin& p, Props& props, const pugi::xml_node& c, std::shared_ptr<Props> tex) {
+        std::string name = c.attribute("name").value();
+        if (name.empty()) src.fail(c, p.where, "<" + std::string(c.name()) + "> for a texture parameter needs name=\"<parameter>\"");
+        if (props.has(name)) src.fail(c, p.where + "." + name, "property '" + name + "' is given twice");
+        props.values[name] = std::move(tex);
     }
 
     Props to_props(const Plugin& p) const {
@@ -200,16 +242,24 @@ private:
             if (tag == "bsdf") child = read_bsdf(c, p.where + ".bsdf");
             else if (tag == "ref") {
                 IdEntry& e = resolve_ref(c);
-                if (e.tag != "bsdf") src.fail(c, p.where, "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag + ">, expected a <bsdf>");
-                child = e.bsdf;
-            } else if (tag == "texture") fail_texture(c);
-            else unexpected_child(p, c);
+                if (e.tag == "texture") {
+                    add_texture(p, *props, c, e.props);
+                    continue;
+                }
+                if (e.tag != "bsdf") src.fail(c, p.where, "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag + ">, expected a <bsdf> or <texture>");
+                child = e.props;
+            } else if (tag == "texture") {
+                add_texture(p, *props, c, read_texture(c, p.where + "." + c.attribute("name").value()));
+                continue;
+            } else unexpected_child(p, c);
             if (++nested == 1) props->values["bsdf"] = child;
         }
         try {
             make_bsdf<3>(*props);
         } catch (const SceneError& e) {
-            rethrow_at(src, e, p.line);
+            // A texture under a key the BSDF reads as a plain colour: say so rather than
+            // "expected an rgb triple".
+            rethrow_at(src, explain_texture_error(*props, e), p.line);
         }
         if (nested > 0 && p.type != "twosided") src.fail(n, p.where, "bsdf '" + p.type + "' does not take a nested BSDF");
         if (nested > 1) src.fail(n, p.where, "twosided with a separate back-side BSDF is not supported (give one nested BSDF)");
@@ -337,7 +387,7 @@ private:
     Emitter read_emitter_props(const Plugin& p, EmitterKind kind) {
         allow_only(p, {"radiance"});
         for (const pugi::xml_node& c : p.children) {
-            if (std::string(c.name()) == "texture") fail_texture(c);
+            if (std::string(c.name()) == "texture") fail_texture(p, c);
             unexpected_child(p, c);
         }
         Emitter e;
@@ -362,8 +412,9 @@ private:
             if (!p.find("filename")) src.fail_at(p.line, p.where + ".filename", "missing");
             fs::path mp = dir / get_string(p, "filename", "");
             try {
-                // Mitsuba's obj flips v by default (flip_tex_coords = true).
-                shape.mesh = t == "obj" ? load_obj(mp.string(), get_bool(p, "flip_tex_coords", true)) : load_ply(mp.string());
+                // Mitsuba's obj flips v by default (flip_tex_coords = true) and drops zero-area
+                // triangles (the classroom's Mesh042 has two).
+                shape.mesh = t == "obj" ? load_obj(mp.string(), get_bool(p, "flip_tex_coords", true), true) : load_ply(mp.string());
             } catch (const SceneError& e) {
                 fail_value(p, "filename", e.what());
             }
@@ -390,7 +441,7 @@ private:
             for (auto& nn : m.normals) nn = -nn;
         }
         try {
-            validate_mesh(shape.mesh, src.path(), p.where, false);
+            validate_mesh(shape.mesh, src.path(), p.where, true);  // as Mitsuba: drop, don't fail
         } catch (const SceneError& e) {
             rethrow_at(src, e, p.line);
         }
@@ -408,7 +459,7 @@ private:
                     IdEntry& e = resolve_ref(c);
                     if (e.tag == "medium") continue;  // interior/exterior media are ignored
                     if (e.tag != "bsdf") src.fail(c, p.where, "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag + ">; a shape takes a <bsdf>");
-                    if (e.material < 0) e.material = add_material(*e.bsdf);
+                    if (e.material < 0) e.material = add_material(*e.props);
                     material = e.material;
                 }
                 if (shape.material >= 0) src.fail(c, p.where, "shape has more than one BSDF");
@@ -425,7 +476,7 @@ private:
             } else if (tag == "medium") {
                 skip_medium(c);
             } else if (tag == "texture") {
-                fail_texture(c);
+                fail_texture(p, c);
             } else {
                 unexpected_child(p, c);
             }

@@ -107,7 +107,7 @@ struct CornerHash {
 
 }  // namespace
 
-TriangleMesh load_obj(const std::string& path, bool flip_v) {
+TriangleMesh load_obj(const std::string& path, bool flip_v, bool drop_degenerate) {
     const std::string text = read_file(path);
     const std::vector<int> face_lines = prescan(path, text);
 
@@ -183,7 +183,7 @@ TriangleMesh load_obj(const std::string& path, bool flip_v) {
     // (geometric) normals everywhere is the predictable choice. Missing uvs read as (0, 0).
     if (!all_have_normals) mesh.normals.clear();
     if (!any_uv) mesh.uvs.clear();
-    validate_mesh(mesh, path, "");
+    validate_mesh(mesh, path, "", drop_degenerate);
     return mesh;
 }
 

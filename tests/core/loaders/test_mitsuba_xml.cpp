@@ -1,9 +1,14 @@
 // Mitsuba 3 XML loader: parameters, transforms, properties, plugins, and errors that name the
 // file, XML line and offending plugin; plus the scenes in ../shared/scenes when present.
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/scene_loader.h"
 #include "test_util.h"
+#include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
+#include <regex>
+#include <sstream>
 
 using namespace lpt;
 
@@ -257,8 +262,6 @@ TEST(MitsubaXml, UnsupportedFeaturesAreErrors) {
     };
     std::string env = R"(<emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>)";
     check("envmap.xml", scene_xml("\n" + kQuad + "\n" + env), "envmap", "envmap is not supported yet");
-    std::string tex = R"(<bsdf type="diffuse"><texture name="reflectance" type="bitmap"><string name="filename" value="a.jpg"/></texture></bsdf>)";
-    check("bitmap.xml", scene_xml("\n<shape type=\"cube\">\n" + tex + "\n</shape>"), "<texture", "textured parameters are not supported yet");
     std::string gauss = kSensor;
     gauss.replace(gauss.find("\"box\""), 5, "\"gaussian\"");
     check("gauss.xml", scene_xml(kQuad, gauss), "gaussian", "unsupported, use box or tent");
@@ -267,6 +270,108 @@ TEST(MitsubaXml, UnsupportedFeaturesAreErrors) {
     check("diag.xml", scene_xml(kQuad, diag), "diagonal", "diagonal");
     check("prop.xml", scene_xml("\n<shape type=\"cube\"><float name=\"radius\" value=\"2\"/></shape>"), "radius", "does not support property 'radius'");
     check("twoback.xml", scene_xml("\n<bsdf type=\"twosided\" id=\"t\"><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>\n" + kQuad), "twosided", "back-side");
+}
+
+namespace {
+
+/// A 2x1 EXR (left red, right blue) in the tests' temp folder, as `name`.
+std::string write_texture(const std::string& name) {
+    std::string path = (std::filesystem::path(test::write_temp_file("xml-tex-marker.txt", "")).parent_path() / name).string();
+    Image img;
+    img.width = 2;
+    img.height = 1;
+    img.channels = 3;
+    img.data = {1, 0, 0, 0, 0, 1};
+    write_exr(path, img);
+    return path;
+}
+
+const Props& nested(const Scene& s, int material) {
+    const Props& m = s.materials[material];
+    return m.type == "twosided" ? *m.get_child("bsdf") : m;
+}
+
+}  // namespace
+
+TEST(MitsubaXml, BitmapTextures) {
+    std::string tex_path = write_texture("xml-tex.exr");
+    // Inline in a BSDF, and top-level with an id used through <ref name id>.
+    std::string xml = scene_xml(R"(
+<texture type="bitmap" id="shared">
+  <string name="filename" value="xml-tex.exr"/>
+  <string name="wrap_mode" value="clamp"/>
+</texture>
+<shape type="rectangle" id="a">
+  <bsdf type="twosided"><bsdf type="diffuse">
+    <texture type="bitmap" name="reflectance">
+      <string name="filename" value="xml-tex.exr"/>
+      <string name="filter_type" value="nearest"/>
+      <boolean name="raw" value="true"/>
+    </texture>
+  </bsdf></bsdf>
+</shape>
+<shape type="rectangle" id="b">
+  <bsdf type="diffuse"><ref name="reflectance" id="shared"/></bsdf>
+</shape>)");
+    Scene s = load_xml("textured.xml", xml);
+    ASSERT_EQ(s.shapes.size(), 2u);
+    auto a = nested(s, s.shapes[0].material).get_child("reflectance");
+    auto b = nested(s, s.shapes[1].material).get_child("reflectance");
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(a->type, "bitmap");
+    std::string file = std::get<std::string>(a->values.at("filename"));
+    EXPECT_TRUE(std::filesystem::path(file).is_absolute()) << file;
+    EXPECT_TRUE(std::filesystem::equivalent(file, tex_path));
+    EXPECT_EQ(std::get<std::string>(a->values.at("filter_type")), "nearest");
+    EXPECT_TRUE(std::get<bool>(a->values.at("raw")));
+    EXPECT_EQ(std::get<std::string>(b->values.at("wrap_mode")), "clamp");
+    EXPECT_TRUE(std::filesystem::equivalent(std::get<std::string>(b->values.at("filename")), tex_path));
+
+    auto check = [](const std::string& name, const std::string& xml, const std::string& needle, const std::string& msg) {
+        std::string err = load_error(name, xml);
+        expect_has(err, at_line(name, line_of(xml, needle)));
+        expect_has(err, msg);
+    };
+    auto in_bsdf = [](const std::string& bsdf, const std::string& texture) {
+        return scene_xml("\n<bsdf type=\"" + bsdf + "\" id=\"m\">\n" + texture + "\n</bsdf>\n" + kQuad);
+    };
+    const std::string ok_file = R"(<string name="filename" value="xml-tex.exr"/>)";
+    // A missing image: at the texture's line, naming the file.
+    check("texmissing.xml", in_bsdf("diffuse", R"(<texture type="bitmap" name="reflectance"><string name="filename" value="nowhere.jpg"/></texture>)"),
+          "<texture", "nowhere.jpg");
+    check("texchecker.xml", in_bsdf("diffuse", R"(<texture type="checkerboard" name="reflectance"/>)"), "checkerboard",
+          "unknown texture plugin 'checkerboard'");
+    check("texuv.xml", in_bsdf("diffuse", "<texture type=\"bitmap\" name=\"reflectance\">" + ok_file + "\n<transform name=\"to_uv\"><scale value=\"2\"/></transform></texture>"),
+          "to_uv", "to_uv is not supported yet");
+    check("texfilter.xml", in_bsdf("diffuse", "<texture type=\"bitmap\" name=\"reflectance\">" + ok_file + "\n<string name=\"filter_type\" value=\"trilinear\"/></texture>"),
+          "trilinear", "expected bilinear or nearest");
+    check("texnoname.xml", in_bsdf("diffuse", "<texture type=\"bitmap\">" + ok_file + "</texture>"), "<texture", "needs name=");
+    check("textwice.xml", in_bsdf("diffuse", "<rgb name=\"reflectance\" value=\"0.5\"/>\n<texture type=\"bitmap\" name=\"reflectance\">" + ok_file + "</texture>"),
+          "<texture", "given twice");
+    // A BSDF that reads the key as a plain colour: named as such, at the BSDF's line.
+    check("texcond.xml", in_bsdf("conductor", "<texture type=\"bitmap\" name=\"specular_reflectance\">" + ok_file + "</texture>"),
+          "conductor", "textured specular_reflectance on conductor is not supported yet");
+    // Textures belong to BSDFs only.
+    check("texemit.xml", scene_xml("\n<shape type=\"rectangle\"><emitter type=\"area\">\n<texture type=\"bitmap\" name=\"radiance\">" + ok_file + "</texture></emitter></shape>"),
+          "<texture", "textured 'radiance' on <emitter type=\"area\"> is not supported yet");
+    check("texnoid.xml", scene_xml("\n<texture type=\"bitmap\">" + ok_file + "</texture>\n" + kQuad), "<texture", "needs an id");
+}
+
+TEST(MitsubaXml, ZeroAreaTrianglesAreDroppedAsMitsubaDoes) {
+    // Triangle 2 repeats a vertex. Mitsuba drops it; so does our XML loader, while the JSON
+    // format rejects it.
+    std::string obj = test::write_temp_file("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 3\nf 1 3 4\n");
+    Scene s = load_xml("degenerate.xml", scene_xml("\n<shape type=\"obj\" id=\"m\"><string name=\"filename\" value=\"degenerate.obj\"/></shape>"));
+    EXPECT_EQ(s.shapes[0].mesh.triangle_count(), 2u);
+    std::string json = test::write_temp_file("degenerate.json", R"({"camera": {}, "materials": {"w": {"type": "diffuse"}},
+        "shapes": [{"type": "obj", "filename": "degenerate.obj", "material": "w"}]})");
+    std::string err;
+    try {
+        load_scene(json);
+    } catch (const SceneError& e) {
+        err = e.what();
+    }
+    expect_has(err, "zero area");
 }
 
 TEST(MitsubaXml, UndefinedRefNamesIdAndLine) {
@@ -375,12 +480,41 @@ TEST(MitsubaXml, SharedSceneDetails) {
     for (const Vec3f& p : sphere.mesh.positions) ASSERT_NEAR((p - Vec3f(-3, 4, 0)).norm(), 0.4f, 1e-5f);
     EXPECT_TRUE(d.emitters[sphere.emitter].radiance_rgb.isApprox(Eigen::Array3f::Constant(65.f)));
 
-    // The classroom needs bitmap textures; the loader says so at the first one.
+}
+
+TEST(MitsubaXml, ClassroomWithBitmapTextures) {
+    std::string shared = test::shared_dir();
+    if (shared.empty()) GTEST_SKIP() << "../shared not found (set LATENTPT_SHARED)";
+    const std::string dir = shared + "/scenes/classroom";
+    // The desks' roughplastic takes its diffuse_reflectance from wood2.jpg, which roughplastic
+    // cannot read yet: the loader names the plugin and field. When roughplastic learns
+    // textures, this becomes a plain load (and the copy below can go).
     std::string err;
     try {
-        load_scene(shared + "/scenes/classroom/scene_constant.xml");
+        load_scene(dir + "/scene_constant.xml");
     } catch (const SceneError& e) {
         err = e.what();
     }
-    expect_has(err, "textured parameters are not supported yet");
+    expect_has(err, "ChairWoodBSDF");
+    expect_has(err, "textured diffuse_reflectance on roughplastic is not supported yet");
+
+    // Everything else loads: the same file with that one texture replaced by its mean colour
+    // and every relative path made absolute, written to the temp folder.
+    std::ifstream in(dir + "/scene_constant.xml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string xml = ss.str();
+    std::regex plastic_tex(R"(<texture name="diffuse_reflectance" type="bitmap">[\s\S]*?</texture>)");
+    ASSERT_EQ(std::distance(std::sregex_iterator(xml.begin(), xml.end(), plastic_tex), std::sregex_iterator()), 1);
+    xml = std::regex_replace(xml, plastic_tex, R"(<rgb name="diffuse_reflectance" value="0.33, 0.17, 0.07"/>)");
+    xml = std::regex_replace(xml, std::regex(R"(value="(models|textures)/)"), "value=\"" + dir + "/$1/");
+    Scene s = load_xml("classroom-copy.xml", xml, {{"res", "32"}});
+    EXPECT_EQ(s.shapes.size(), 79u);
+    int textured = 0;
+    for (size_t i = 0; i < s.materials.size(); ++i) {
+        const Props& m = nested(s, int(i));
+        if (auto it = m.values.find("reflectance"); it != m.values.end())
+            if (auto* child = std::get_if<std::shared_ptr<Props>>(&it->second); child && (*child)->type == "bitmap") ++textured;
+    }
+    EXPECT_GE(textured, 1);  // the lectern (wood1.jpg) and the board frames (blackboard.jpg)
 }
