@@ -1,4 +1,5 @@
-// Beckmann and GGX microfacet distributions. Equations: docs/bsdfs.md (5)-(12).
+// Beckmann and GGX microfacet distributions. Equations: docs/bsdfs.md (5)-(12); roughness
+// derivatives (37)-(39).
 #include "core/bsdfs/microfacet.h"
 #include <algorithm>
 #include <cmath>
@@ -7,7 +8,9 @@
 namespace lpt {
 
 MicrofacetDistribution::MicrofacetDistribution(MicrofacetType type, float alpha)
-    : m_type(type), m_alpha(std::max(alpha, 1e-4f)) {}
+    : m_type(type), m_alpha(std::max(alpha, kMinAlpha)) {}
+
+void MicrofacetDistribution::set_alpha(float alpha) { m_alpha = std::max(alpha, kMinAlpha); }
 
 float MicrofacetDistribution::D(const Vec3f& m) const {
     float c2 = m.z() * m.z();
@@ -31,6 +34,50 @@ float MicrofacetDistribution::G1(const Vec3f& v, const Vec3f& m) const {
     double a = 1.0 / std::sqrt(double(at2));
     double lambda = 0.5 * (std::exp(-a * a) / (a * std::sqrt(double(kPi))) - std::erfc(a));
     return float(1.0 / (1.0 + std::max(0.0, lambda)));
+}
+
+std::pair<float, float> MicrofacetDistribution::D_dalpha(const Vec3f& m) const {
+    if (m.z() <= 0.f) return {0.f, 0.f};
+    // D exactly as D(); the derivative is D times the closed-form d ln D / dα, (37).
+    float c2 = m.z() * m.z();
+    float t2 = (m.x() * m.x() + m.y() * m.y()) / c2;
+    float a2 = m_alpha * m_alpha;
+    // D == 0 (far tail, or tan²θm overflowing for m.z ~ 0): the derivative's limit is 0; the
+    // guard keeps 0 · inf out.
+    if (m_type == MicrofacetType::Beckmann) {  // d ln D/dα = 2 (tan²θm − α²) / α³
+        float D = std::exp(-t2 / a2) / (kPi * a2 * c2 * c2);
+        if (D == 0.f) return {D, 0.f};
+        return {D, D * (2.f * (t2 - a2) / (a2 * m_alpha))};
+    }
+    float b = 1.f + t2 / a2;  // GGX: d ln D/dα = 2 (tan²θm − α²) / (α (α² + tan²θm))
+    float D = 1.f / (kPi * a2 * c2 * c2 * b * b);
+    if (D == 0.f) return {D, 0.f};
+    return {D, D * (2.f * (t2 - a2) / (m_alpha * (a2 + t2)))};
+}
+
+std::pair<float, float> MicrofacetDistribution::G1_dalpha(const Vec3f& v, const Vec3f& m) const {
+    // Same cases and value as G1(); docs/bsdfs.md (7), (38).
+    if (v.dot(m) * v.z() <= 0.f) return {0.f, 0.f};
+    float xy2 = v.x() * v.x() + v.y() * v.y();
+    if (xy2 == 0.f) return {1.f, 0.f};
+    float at2 = m_alpha * m_alpha * xy2 / (v.z() * v.z());  // (alpha tan theta_v)^2
+    // v.z ~ 0 overflows α² tan²θv: G1 evaluates to exactly 0 there and ∂G1/∂α → 0 (both
+    // formulas below would give 0 · inf).
+    if (std::isinf(at2)) return {0.f, 0.f};
+    if (m_type == MicrofacetType::GGX) {
+        // G1 = 2 / (1 + s), s = sqrt(1 + α² tan²θv): ∂G1/∂α = −2 α tan²θv / (s (1 + s)²),
+        // as −2 (at2 / s) / (α (1 + s)²) so that no intermediate overflows.
+        float s = std::sqrt(1.f + at2);
+        return {2.f / (1.f + s), -2.f * (at2 / s) / (m_alpha * (1.f + s) * (1.f + s))};
+    }
+    // Beckmann, in double as G1: with a = 1/(α tan θv), dΛ/da = −exp(−a²) / (2 a² √π) (the
+    // erfc term's derivative, −2/√π exp(−a²), cancels most of the first term's), da/dα = −a/α,
+    // so dΛ/dα = exp(−a²) / (2 a α √π) and ∂G1/∂α = −G1² dΛ/dα.
+    double a = 1.0 / std::sqrt(double(at2));
+    double e = std::exp(-a * a), sqrt_pi = std::sqrt(double(kPi));
+    double lambda = 0.5 * (e / (a * sqrt_pi) - std::erfc(a));
+    double g1 = 1.0 / (1.0 + std::max(0.0, lambda));
+    return {float(g1), float(-g1 * g1 * e / (2.0 * a * double(m_alpha) * sqrt_pi))};
 }
 
 Vec3f MicrofacetDistribution::sample(const Vec3f& wi, const Vec2f& u) const {

@@ -5,8 +5,9 @@
 // neither eta nor k (or material "none") is a perfect F = 1 conductor. That is also what
 // Mitsuba 3's code does (material defaults to "none" → eta 0, k 1), although Mitsuba's docs and
 // Mitsuba 0.6 name copper as the default; copper needs an IOR database, which we do not ship.
-// Gradients: ∂/∂specular_reflectance of eval and of the sample weight, docs/bsdfs.md (30)-(31).
-// Equations: docs/bsdfs.md (10), (12), (15)-(16), (30)-(31).
+// Gradients: ∂/∂specular_reflectance of eval and of the sample weight, docs/bsdfs.md (30)-(31);
+// scalar key "alpha" (roughness), ∂/∂α of eval and of the weight, docs/bsdfs.md (37)-(40), (43).
+// Equations: docs/bsdfs.md (10), (12), (15)-(16), (30)-(31), (37)-(40), (43).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/microfacet.h"
@@ -76,6 +77,33 @@ public:
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
         if (key != "specular_reflectance") BSDF<N>::set_spectral(key, v);
         m_specular = v;
+    }
+
+    std::vector<std::string> scalar_keys() const override { return {"alpha"}; }
+    float get_scalar(const std::string& key) const override {
+        if (key != "alpha") return BSDF<N>::get_scalar(key);
+        return m_distr.alpha();
+    }
+    /// Raised to MicrofacetDistribution::kMinAlpha (1e-4) as at construction; nothing else
+    /// caches alpha. Non-finite values throw std::invalid_argument.
+    void set_scalar(const std::string& key, float value) override {
+        if (key != "alpha") BSDF<N>::set_scalar(key, value);
+        if (!std::isfinite(value)) throw std::invalid_argument("roughconductor: alpha must be finite");
+        m_distr.set_alpha(value);
+    }
+    /// ∂(f·|cos wo|)/∂α = specular_reflectance · F(wi·h) (∂D G + D ∂G) / (4 cos θi),
+    /// docs/bsdfs.md (40): (15) by the product rule with (37)-(39); same zero cases as eval.
+    /// weight_grad_scalar keeps the base-class default (∂eval/∂α)/pdf, docs/bsdfs.md (43):
+    /// sample() returns the closed form colour·F·w(12), which equals eval/pdf, but w's own
+    /// α-derivative also contains -eval·(∂pdf/∂α)/pdf² (the sampling density moves with α);
+    /// path replay holds bs.wo and bs.pdf fixed, so only the numerator is differentiated.
+    Spectrum<N> eval_grad_scalar(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        if (key != 0) throw std::invalid_argument("roughconductor: scalar key index out of range");
+        if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
+        Vec3f h = (wi + wo).normalized();
+        float dvalue = m_distr.dDG_dalpha(wi, wo, h) / (4.f * cos_theta(wi));
+        if (dvalue == 0.f) return Spectrum<N>::Zero();
+        return m_specular * m_ior.fresnel(wi.dot(h)) * dvalue;
     }
 
 private:

@@ -6,8 +6,9 @@
 // int_ior (default 1.5046 = BK7), ext_ior (default 1.000277 = air), > 0 and distinct;
 // specular_reflectance, specular_transmittance (rgb, default 1).
 // Transmitted radiance is scaled by 1/eta^2 in TransportMode::Radiance only.
-// Gradients w.r.t. the two colours (keys 0 and 1): docs/bsdfs.md (32)-(33).
-// Equations: docs/bsdfs.md (1)-(2), (7)-(12), (18)-(21), (32)-(33).
+// Gradients w.r.t. the two colours (keys 0 and 1): docs/bsdfs.md (32)-(33); w.r.t. the scalar
+// key "alpha" (roughness): docs/bsdfs.md (37)-(39), (41), (43).
+// Equations: docs/bsdfs.md (1)-(2), (7)-(12), (18)-(21), (32)-(33), (37)-(39), (41), (43).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/microfacet.h"
@@ -130,6 +131,38 @@ public:
         if (key == "specular_reflectance") m_reflectance = v;
         else if (key == "specular_transmittance") m_transmittance = v;
         else BSDF<N>::set_spectral(key, v);
+    }
+
+    std::vector<std::string> scalar_keys() const override { return {"alpha"}; }
+    float get_scalar(const std::string& key) const override {
+        if (key != "alpha") return BSDF<N>::get_scalar(key);
+        return m_distr.alpha();
+    }
+    /// Raised to MicrofacetDistribution::kMinAlpha (1e-4) as at construction; nothing else
+    /// caches alpha. Non-finite values throw std::invalid_argument.
+    void set_scalar(const std::string& key, float value) override {
+        if (key != "alpha") BSDF<N>::set_scalar(key, value);
+        if (!std::isfinite(value)) throw std::invalid_argument("roughdielectric: alpha must be finite");
+        m_distr.set_alpha(value);
+    }
+    /// ∂(f·|cos wo|)/∂α, docs/bsdfs.md (41): (19) and (20) with D G replaced by
+    /// ∂(D G)/∂α = ∂D G + D ∂G from (37)-(39). D, G >= 0, so |(1 - F) D G X| = D G |(1 - F) X|
+    /// and the absolute value passes to the α-free factor. F, η, the half vector and s (18) do
+    /// not depend on α. weight_grad_scalar keeps the base-class default (∂eval/∂α)/pdf,
+    /// docs/bsdfs.md (43): sample() returns colour·w(12)(·s), equal to eval/pdf, and path
+    /// replay holds bs.wo and bs.pdf (including the Fresnel lobe probability) fixed.
+    Spectrum<N> eval_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        if (key != 0) throw std::invalid_argument("roughdielectric: scalar key index out of range");
+        Half h;
+        if (!half_vector(wi, wo, h)) return Spectrum<N>::Zero();
+        if (m_distr.D(h.m) == 0.f) return Spectrum<N>::Zero();  // same zero cases as eval
+        float dDG = m_distr.dDG_dalpha(wi, wo, h.m);
+        float F = fresnel(h);
+        float cos_i = cos_theta(wi);
+        if (h.reflect) return m_reflectance * (F * dDG / (4.f * std::abs(cos_i)));
+        float denom = h.wi_m + h.eta * h.wo_m;
+        float factor = std::abs((1.f - F) * h.eta * h.eta * h.wi_m * h.wo_m / (cos_i * denom * denom));
+        return m_transmittance * (dDG * factor * radiance_scale(ctx, h.eta));
     }
 
 private:

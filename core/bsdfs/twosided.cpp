@@ -3,7 +3,8 @@
 // tangent plane (z negated) so the nested BSDF sees its front side, and results mirrored back.
 // Keys: bsdf (nested object, required; a reflection-only BSDF — transmissive BSDFs are
 // two-sided already and are rejected, as in Mitsuba 3).
-// Equations: docs/bsdfs.md (29).
+// Scalar parameters (roughness) are the nested BSDF's, forwarded with the same mirroring.
+// Equations: docs/bsdfs.md (29), (43).
 #include "core/bsdf.h"
 
 namespace lpt {
@@ -52,6 +53,20 @@ public:
     }
     std::vector<std::string> spectral_keys() const override { return m_nested->spectral_keys(); }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override { m_nested->set_spectral(key, v); }
+
+    std::vector<std::string> scalar_keys() const override { return m_nested->scalar_keys(); }
+    float get_scalar(const std::string& key) const override { return m_nested->get_scalar(key); }
+    void set_scalar(const std::string& key, float value) override { m_nested->set_scalar(key, value); }
+    Spectrum<N> eval_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        return cos_theta(wi) < 0.f ? m_nested->eval_grad_scalar(ctx, flip_z(wi), flip_z(wo), key)
+                                   : m_nested->eval_grad_scalar(ctx, wi, wo, key);
+    }
+    Spectrum<N> weight_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const override {
+        if (cos_theta(wi) >= 0.f) return m_nested->weight_grad_scalar(ctx, wi, bs, key);
+        BSDFSample<N> flipped = bs;
+        flipped.wo = flip_z(bs.wo);
+        return m_nested->weight_grad_scalar(ctx, flip_z(wi), flipped, key);
+    }
 
 private:
     std::unique_ptr<BSDF<N>> m_nested;

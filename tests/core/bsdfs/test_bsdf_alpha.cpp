@@ -1,0 +1,500 @@
+// Roughness alpha as a fit parameter (docs/bsdfs.md (37)-(43)): the analytic ∂D/∂α, ∂G1/∂α of
+// both microfacet distributions against central differences; every rough plugin's
+// eval_grad_scalar against central differences of eval at fixed (wi, wo), per channel;
+// weight_grad_scalar == eval_grad_scalar / pdf; set_scalar re-deriving everything cached from
+// alpha; key handling. Deterministic point sets (sample_1d), so thresholds are real.
+#include "core/bsdf.h"
+#include "core/bsdfs/microfacet.h"
+#include "core/sampler.h"
+#include <gtest/gtest.h>
+#include <cmath>
+
+using namespace lpt;
+
+namespace {
+
+constexpr MicrofacetType kTypes[] = {MicrofacetType::Beckmann, MicrofacetType::GGX};
+const char* name(MicrofacetType t) { return t == MicrofacetType::GGX ? "ggx" : "beckmann"; }
+
+Vec3f sphere(float u, float v) {
+    float z = 2.f * u - 1.f, r = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * v;
+    return Vec3f(r * std::cos(phi), r * std::sin(phi), z);
+}
+
+// Double-precision twins of D (5)/(6) and G1 (7), the same expressions as microfacet.cpp. The
+// float functions cannot be differenced at h = 1e-4 α: one float rounding of D (6e-8 |D|)
+// divided by 2h is ~3e-4 |D|/α, the size of the tolerance itself. ReferenceMatchesFloat
+// checks that these twins are the functions the code computes.
+double ref_D(MicrofacetType type, double alpha, const Vec3f& mf) {
+    Eigen::Vector3d m = mf.cast<double>();
+    if (m.z() <= 0.0) return 0.0;
+    double c2 = m.z() * m.z(), t2 = (m.x() * m.x() + m.y() * m.y()) / c2, a2 = alpha * alpha;
+    if (type == MicrofacetType::Beckmann) return std::exp(-t2 / a2) / (M_PI * a2 * c2 * c2);
+    double b = 1.0 + t2 / a2;
+    return 1.0 / (M_PI * a2 * c2 * c2 * b * b);
+}
+
+double ref_G1(MicrofacetType type, double alpha, const Vec3f& vf, const Vec3f& mf) {
+    if (vf.dot(mf) * vf.z() <= 0.f) return 0.0;  // the same float test as G1
+    Eigen::Vector3d v = vf.cast<double>();
+    double xy2 = v.x() * v.x() + v.y() * v.y();
+    if (xy2 == 0.0) return 1.0;
+    double at2 = alpha * alpha * xy2 / (v.z() * v.z());
+    if (type == MicrofacetType::GGX) return 2.0 / (1.0 + std::sqrt(1.0 + at2));
+    double a = 1.0 / std::sqrt(at2);
+    double lambda = 0.5 * (std::exp(-a * a) / (a * std::sqrt(M_PI)) - std::erfc(a));
+    return 1.0 / (1.0 + std::max(0.0, lambda));
+}
+
+// Microfacet normals: half from the sampler (where D matters), half uniform over the upper
+// hemisphere (tails); directions v uniform over the sphere (both sides, both signs of v·m).
+struct Pair {
+    Vec3f v, m;
+};
+std::vector<Pair> microfacet_points(const MicrofacetDistribution& d, int n) {
+    std::vector<Pair> out;
+    for (uint32_t i = 0; i < uint32_t(n); ++i) {
+        Vec3f v = sphere(sample_1d(11, i, 0, 0), sample_1d(11, i, 0, 1));
+        Vec2f u(sample_1d(11, i, 0, 2), sample_1d(11, i, 0, 3));
+        Vec3f m = i % 2 ? d.sample(v.z() < 0.f ? Vec3f(-v) : v, u) : sphere(0.5f + 0.5f * u.x(), u.y());
+        out.push_back({v, m});
+    }
+    return out;
+}
+
+std::shared_ptr<Props> props(const std::string& type, const std::string& distr = "", float alpha = 0.3f) {
+    auto p = std::make_shared<Props>();
+    p->type = type;
+    p->file = "test";
+    if (type.rfind("rough", 0) == 0) {
+        p->values["alpha"] = alpha;
+        p->values["distribution"] = distr;
+    }
+    return p;
+}
+std::shared_ptr<Props> twosided(std::shared_ptr<Props> nested) {
+    auto p = props("twosided");
+    p->values["bsdf"] = std::move(nested);
+    return p;
+}
+Spectrum<16> ramp(float a, float b) {
+    Spectrum<16> s;
+    for (int c = 0; c < 16; ++c) s[c] = a + b * float(c) / 15.f;
+    return s;
+}
+
+struct Case {
+    std::string name;
+    std::shared_ptr<Props> p;
+    std::vector<std::pair<std::string, Spectrum<16>>> colours;  ///< set_spectral after construction
+    TransportMode mode = TransportMode::Radiance;
+};
+
+// The rough plugins with both distributions, signed latent colours and per-channel Fresnel.
+// Roughplastic appears split by lobe (the other colour zero): its specular lobe is exact, its
+// diffuse lobe carries the table approximation (42), tested separately.
+std::vector<Case> rough_cases(bool plastic_diffuse) {
+    std::vector<Case> cases;
+    const Spectrum<16> c1 = ramp(-0.4f, 1.3f), c2 = ramp(0.9f, -0.6f), zero = Spectrum<16>::Zero();
+    const PropValue eta = Eigen::Array3f(0.2f, 0.9f, 1.1f), k = Eigen::Array3f(3.9f, 2.4f, 2.2f);
+    for (const char* d : {"beckmann", "ggx"}) {
+        std::string D = d;
+        if (plastic_diffuse) {
+            for (bool nonlinear : {false, true}) {
+                auto p = props("roughplastic", D);
+                p->values["nonlinear"] = nonlinear;
+                cases.push_back({"roughplastic diffuse " + D + (nonlinear ? " nonlinear" : ""), p,
+                                 {{"diffuse_reflectance", nonlinear ? ramp(-0.4f, 0.9f) : c1}, {"specular_reflectance", zero}}});
+            }
+            continue;
+        }
+        auto cond = props("roughconductor", D);
+        cond->values["eta"] = eta, cond->values["k"] = k;
+        cases.push_back({"roughconductor " + D, cond, {{"specular_reflectance", c1}}});
+        cases.push_back({"twosided roughconductor " + D, twosided(cond), {{"specular_reflectance", c1}}});
+        for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance})
+            cases.push_back({"roughdielectric " + D + (mode == TransportMode::Radiance ? " radiance" : " importance"),
+                             props("roughdielectric", D),
+                             {{"specular_reflectance", c1}, {"specular_transmittance", c2}},
+                             mode});
+        cases.push_back({"roughplastic specular " + D, props("roughplastic", D),
+                         {{"specular_reflectance", c1}, {"diffuse_reflectance", zero}}});
+    }
+    return cases;
+}
+
+std::unique_ptr<BSDF<16>> build(const Case& cs) {
+    auto bsdf = make_bsdf<16>(*cs.p);
+    for (const auto& [key, v] : cs.colours) bsdf->set_spectral(key, v);
+    return bsdf;
+}
+
+// (wi, wo) pairs: wi over both faces (one-sided plugins must give zero gradients below), wo
+// alternately sampled by the BSDF at the current alpha (inside the lobe) and uniform on the
+// sphere (tails, the other side).
+std::vector<std::pair<Vec3f, Vec3f>> direction_pairs(const BSDF<16>& bsdf, uint64_t seed, int n) {
+    std::vector<std::pair<Vec3f, Vec3f>> out;
+    for (uint32_t i = 0; i < uint32_t(n); ++i) {
+        float z = (i % 4 < 3 ? 1.f : -1.f) * (0.05f + 0.95f * sample_1d(seed, i, 0, 0));
+        float r = std::sqrt(1.f - z * z), phi = 2.f * kPi * sample_1d(seed, i, 0, 1);
+        Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
+        Vec3f wo = sphere(sample_1d(seed, i, 0, 2), sample_1d(seed, i, 0, 3));
+        if (i % 2) {
+            BSDFSample<16> bs = bsdf.sample(BSDFContext{}, wi, sample_1d(seed, i, 0, 4),
+                                            Vec2f(sample_1d(seed, i, 0, 5), sample_1d(seed, i, 0, 6)));
+            if (bs.valid()) wo = bs.wo;
+        }
+        out.push_back({wi, wo});
+    }
+    return out;
+}
+
+// Central differences of eval in alpha with steps h and 2h, Richardson-extrapolated
+// ((8 Δ_h − Δ_2h) / 12 h: truncation O(h⁴)), per channel, for every pair; also the analytic
+// gradient and the value at alpha.
+struct FdResult {
+    std::vector<Spectrum<16>> grad, fd, value;
+};
+FdResult differences(BSDF<16>& bsdf, const BSDFContext& ctx, const std::vector<std::pair<Vec3f, Vec3f>>& pairs,
+                     float alpha, float h) {
+    FdResult r;
+    const float as[4] = {alpha + 2.f * h, alpha + h, alpha - h, alpha - 2.f * h};
+    std::vector<Spectrum<16>> e[4];
+    for (int k = 0; k < 4; ++k) {
+        bsdf.set_scalar("alpha", as[k]);
+        for (const auto& [wi, wo] : pairs) e[k].push_back(bsdf.eval(ctx, wi, wo));
+    }
+    bsdf.set_scalar("alpha", alpha);
+    const float s1 = as[1] - as[2], s2 = as[0] - as[3];  // the float steps actually taken
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        r.grad.push_back(bsdf.eval_grad_scalar(ctx, pairs[i].first, pairs[i].second, 0));
+        r.value.push_back(bsdf.eval(ctx, pairs[i].first, pairs[i].second));
+        Spectrum<16> d1 = (e[1][i] - e[2][i]) / s1, d2 = (e[0][i] - e[3][i]) / s2;
+        r.fd.push_back((4.f * d1 - d2) / 3.f);
+    }
+    return r;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+TEST(MicrofacetAlpha, ReferenceMatchesFloat) {
+    for (MicrofacetType type : kTypes)
+        for (float alpha : {0.05f, 0.2f, 0.5f, 0.9f}) {
+            MicrofacetDistribution d(type, alpha);
+            for (const Pair& p : microfacet_points(d, 2048)) {
+                double D = ref_D(type, alpha, p.m), G1 = ref_G1(type, alpha, p.v, p.m);
+                EXPECT_NEAR(d.D(p.m), D, 1e-5 * D + 1e-30) << name(type) << " " << alpha;
+                EXPECT_NEAR(d.G1(p.v, p.m), G1, 1e-6) << name(type) << " " << alpha;
+            }
+        }
+}
+
+TEST(MicrofacetAlpha, DerivativesMatchCentralDifferences) {
+    // h = 1e-4 α in double: truncation h² f'''/6 is < 1e-4 relative even 70 e-folds down the
+    // Beckmann tail (f'''/f' ~ (2 tan²θ/α²)²/α², D still a normal float), rounding ~1e-12. The
+    // analytic derivative is float: relative error ~1e-6, but near its sign change (tan θm = α
+    // for D) its absolute error is a few eps · D/α, hence the floor 1e-5 · value/α.
+    const double rel = 1e-3;
+    for (MicrofacetType type : kTypes)
+        for (float alpha : {0.05f, 0.1f, 0.2f, 0.35f, 0.5f, 0.7f, 0.9f}) {
+            MicrofacetDistribution d(type, alpha);
+            const double a = alpha, h = 1e-4 * a;
+            int nD = 0, nG = 0;
+            for (const Pair& p : microfacet_points(d, 4096)) {
+                const Vec3f& m = p.m;
+                if (d.D(m) > 1e-30f) {  // a normal float with digits to spare
+                    double fd = (ref_D(type, a + h, m) - ref_D(type, a - h, m)) / (2.0 * h);
+                    double g = d.dD_dalpha(m), floor = 1e-5 * ref_D(type, a, m) / a;
+                    EXPECT_LE(std::abs(g - fd), rel * std::abs(fd) + floor) << name(type) << " α " << alpha << " m " << m.transpose();
+                    nD += std::abs(fd) > 1e-2 * ref_D(type, a, m) / a;
+                }
+                double fd = (ref_G1(type, a + h, p.v, m) - ref_G1(type, a - h, p.v, m)) / (2.0 * h);
+                double g = d.dG1_dalpha(p.v, m), floor = 1e-5 * ref_G1(type, a, p.v, m) / a;
+                EXPECT_LE(std::abs(g - fd), rel * std::abs(fd) + floor) << name(type) << " α " << alpha << " v " << p.v.transpose();
+                nG += std::abs(fd) > 1e-2 * ref_G1(type, a, p.v, m) / a;
+                // G = G1 G1: the product rule of dG_dalpha.
+                Vec3f wo = sphere(0.5f + 0.5f * std::abs(p.v.x()), 0.5f + 0.5f * p.v.y());
+                double fdG = (ref_G1(type, a + h, p.v, m) * ref_G1(type, a + h, wo, m) -
+                              ref_G1(type, a - h, p.v, m) * ref_G1(type, a - h, wo, m)) / (2.0 * h);
+                double gG = d.dG_dalpha(p.v, wo, m);
+                EXPECT_LE(std::abs(gG - fdG), rel * std::abs(fdG) + 1e-5 * d.G(p.v, wo, m) / a) << name(type) << " α " << alpha;
+                // D G: the product rule of dDG_dalpha, the factor every rough plugin uses.
+                if (d.D(m) > 1e-30f) {
+                    auto DG = [&](double al) { return ref_D(type, al, m) * ref_G1(type, al, p.v, m) * ref_G1(type, al, wo, m); };
+                    double fdDG = (DG(a + h) - DG(a - h)) / (2.0 * h), gDG = d.dDG_dalpha(p.v, wo, m);
+                    EXPECT_LE(std::abs(gDG - fdDG), rel * std::abs(fdDG) + 1e-5 * DG(a) / a) << name(type) << " α " << alpha;
+                }
+            }
+            EXPECT_GT(nD, 1000) << name(type) << " α " << alpha;  // non-trivial derivatives were compared
+            EXPECT_GT(nG, 200) << name(type) << " α " << alpha;
+        }
+}
+
+TEST(MicrofacetAlpha, FiniteAtDegenerateDirections) {
+    // Grazing directions whose tan² overflows or whose cos⁴ underflows: values as D/G1, and
+    // finite derivatives (no 0 · inf).
+    const std::vector<Vec3f> dirs = {Vec3f(1.f, 0.f, 1e-30f), Vec3f(0.6f, 0.8f, 1e-21f), Vec3f(1.f, 0.f, 1e-12f),
+                                     Vec3f(0.f, 0.f, 1.f), Vec3f(0.f, 0.f, -1.f), Vec3f(1.f, 0.f, 0.f)};
+    for (MicrofacetType type : kTypes)
+        for (float alpha : {1e-4f, 0.3f, 3.f})
+            for (const Vec3f& v : dirs)
+                for (const Vec3f& m : dirs) {
+                    MicrofacetDistribution d(type, alpha);
+                    auto [D, dD] = d.D_dalpha(m);
+                    auto [G1, dG1] = d.G1_dalpha(v, m);
+                    EXPECT_TRUE(D == d.D(m) || (std::isnan(D) && std::isnan(d.D(m)))) << name(type);
+                    EXPECT_EQ(G1, d.G1(v, m)) << name(type);
+                    if (std::isfinite(D)) {
+                        EXPECT_TRUE(std::isfinite(dD)) << name(type) << " " << alpha << " m " << m.transpose();
+                    }
+                    EXPECT_TRUE(std::isfinite(dG1)) << name(type) << " " << alpha << " v " << v.transpose();
+                }
+}
+
+TEST(MicrofacetAlpha, SetAlphaClampsLikeTheConstructor) {
+    for (MicrofacetType type : kTypes) {
+        MicrofacetDistribution d(type, 0.3f);
+        d.set_alpha(0.45f);
+        EXPECT_EQ(d.alpha(), 0.45f);
+        d.set_alpha(1e-6f);
+        EXPECT_EQ(d.alpha(), MicrofacetDistribution::kMinAlpha);
+        EXPECT_EQ(d.alpha(), MicrofacetDistribution(type, 0.f).alpha());
+        d.set_alpha(-1.f);
+        EXPECT_EQ(d.alpha(), 1e-4f);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+TEST(BSDFAlpha, EvalGradMatchesCentralDifferences) {
+    // Exact derivatives (roughconductor, roughdielectric, roughplastic's specular lobe, twosided
+    // from both faces). eval is float, so its differences need a larger step than (37)-(39)'s
+    // h = 1e-4 α: h = 2e-3 α with Richardson extrapolation. Truncation ~h⁴ f⁽⁵⁾/30 < 2e-4
+    // relative down to 70 e-folds of a Beckmann tail; rounding ~10 eps |f| / (2h) per difference,
+    // ~3e-4 |f|/α after extrapolation. Hence the tolerance 1e-3 (|fd| + |f|/α): relative 1e-3 of
+    // the derivative, floored at 1e-3 of the natural scale |f|/α where ∂f/∂α changes sign, and
+    // at 1e-30 absolute: far tails where D or f is (nearly) subnormal carry no digits.
+    const float rel = 1e-3f, tiny = 1e-30f;
+    for (const Case& cs : rough_cases(false))
+        for (float alpha : {0.1f, 0.3f, 0.7f}) {
+            auto bsdf = build(cs);
+            bsdf->set_scalar("alpha", alpha);
+            BSDFContext ctx;
+            ctx.mode = cs.mode;
+            auto pairs = direction_pairs(*bsdf, 21, 512);
+            FdResult r = differences(*bsdf, ctx, pairs, alpha, 2e-3f * alpha);
+            int nonzero = 0;
+            for (size_t i = 0; i < pairs.size(); ++i) {
+                for (int c = 0; c < 16; ++c) {
+                    float g = r.grad[i][c], fd = r.fd[i][c], f = r.value[i][c];
+                    float tol = rel * (std::abs(fd) + std::abs(f) / alpha) + tiny;
+                    EXPECT_LE(std::abs(g - fd), tol) << cs.name << " α " << alpha << " channel " << c << " wi "
+                                                     << pairs[i].first.transpose() << " wo " << pairs[i].second.transpose();
+                    nonzero += std::abs(fd) > 1e-2f * std::abs(f) / alpha && std::abs(fd) > 1e-20f;
+                }
+                EXPECT_TRUE(r.grad[i].isFinite().all()) << cs.name;
+                if (pairs[i].first.z() < 0.f && cs.name.rfind("rough", 0) == 0 && cs.name.find("dielectric") == std::string::npos) {
+                    EXPECT_TRUE((r.grad[i] == 0.f).all()) << cs.name << ": one-sided";
+                }
+            }
+            EXPECT_GT(nonzero, 16 * 100) << cs.name << " α " << alpha;
+        }
+}
+
+TEST(BSDFAlpha, RoughPlasticDiffuseTermWithinTableAccuracy) {
+    // The diffuse lobe's α-dependence runs through the tabulated t(μ) and Fdr_int, rebuilt by
+    // set_scalar. eval_grad_scalar uses a second table, a 32×32 quadrature of the exact
+    // ∂t/∂α integral (docs/bsdfs.md (42)); central differences of eval see instead the
+    // α-slope of t's own 32×32 quadrature, whose nodes move with α. Both converge to the true
+    // derivative: with both tables at 256×256 this mismatch fell to <= 1e-3 of the lobe's
+    // largest derivative (1e-2 for GGX α = 0.1), against 1.4e-2 .. 5.4e-2 measured at 32×32
+    // (largest for GGX α = 0.3, where t's slope at normal incidence is off by a third). Bound:
+    // 8e-2 of max |∂(diffuse)/∂α| over the point set. Leaving the table's α-dependence out
+    // altogether would be a 100% error here (the whole lobe derivative), and dropping any one
+    // of the three diffuse terms of (42) (∂ρ̃/∂α, ∂t_i, ∂t_o) fails the bound (checked).
+    // Step: h = 1e-2 α, Richardson; the lobe is smooth in α (truncation ~1e-8) and a table
+    // entry's float rounding (6e-8) over 2h adds <= 3e-5 to ∂t/∂α.
+    const float bound = 8e-2f;
+    for (const Case& cs : rough_cases(true))
+        for (float alpha : {0.1f, 0.3f, 0.7f}) {
+            auto bsdf = build(cs);
+            bsdf->set_scalar("alpha", alpha);
+            auto pairs = direction_pairs(*bsdf, 31, 256);
+            FdResult r = differences(*bsdf, BSDFContext{}, pairs, alpha, 1e-2f * alpha);
+            float max_fd = 0.f;
+            for (size_t i = 0; i < pairs.size(); ++i) max_fd = std::max(max_fd, r.fd[i].abs().maxCoeff());
+            ASSERT_GT(max_fd, 1e-3f) << cs.name;  // the lobe does depend on alpha
+            for (size_t i = 0; i < pairs.size(); ++i)
+                EXPECT_LE((r.grad[i] - r.fd[i]).abs().maxCoeff(), bound * max_fd)
+                    << cs.name << " α " << alpha << " wi " << pairs[i].first.transpose() << " wo " << pairs[i].second.transpose();
+        }
+}
+
+TEST(BSDFAlpha, RoughPlasticGradientIsTheSumOfItsLobes) {
+    // The full plastic = specular-only + diffuse-only (eval is linear in the colours and the
+    // tables are shared), so no cross term hides between the two tested halves.
+    for (const char* d : {"beckmann", "ggx"})
+        for (bool nonlinear : {false, true}) {
+            auto p = props("roughplastic", d, 0.3f);
+            p->values["nonlinear"] = nonlinear;
+            const Spectrum<16> rd = ramp(-0.4f, 0.9f), rs = ramp(0.9f, -0.6f), zero = Spectrum<16>::Zero();
+            auto full = make_bsdf<16>(*p), spec = make_bsdf<16>(*p), diff = make_bsdf<16>(*p);
+            full->set_spectral("diffuse_reflectance", rd), full->set_spectral("specular_reflectance", rs);
+            spec->set_spectral("diffuse_reflectance", zero), spec->set_spectral("specular_reflectance", rs);
+            diff->set_spectral("diffuse_reflectance", rd), diff->set_spectral("specular_reflectance", zero);
+            for (const auto& [wi, wo] : direction_pairs(*full, 41, 256)) {
+                Spectrum<16> g = full->eval_grad_scalar(BSDFContext{}, wi, wo, 0);
+                Spectrum<16> sum = spec->eval_grad_scalar(BSDFContext{}, wi, wo, 0) + diff->eval_grad_scalar(BSDFContext{}, wi, wo, 0);
+                EXPECT_LE((g - sum).abs().maxCoeff(), 1e-6f * (1.f + g.abs().maxCoeff())) << d;
+            }
+        }
+}
+
+TEST(BSDFAlpha, WeightGradIsEvalGradOverPdf) {
+    // Path replay holds bs.wo and bs.pdf fixed, so ∂weight/∂α = (∂eval/∂α)/pdf for every
+    // non-delta sample (docs/bsdfs.md (43)); no rough plugin overrides the default, twosided
+    // forwards with the mirroring.
+    std::vector<Case> cases = rough_cases(false);
+    const Spectrum<16> c1 = ramp(-0.4f, 1.3f), c2 = ramp(0.9f, -0.6f);
+    for (const char* d : {"beckmann", "ggx"}) {
+        cases.push_back({std::string("roughplastic ") + d, props("roughplastic", d),
+                         {{"diffuse_reflectance", c1}, {"specular_reflectance", c2}}});
+        cases.push_back({std::string("twosided roughplastic ") + d, twosided(props("roughplastic", d)),
+                         {{"diffuse_reflectance", c1}, {"specular_reflectance", c2}}});
+    }
+    for (const Case& cs : cases)
+        for (float alpha : {0.1f, 0.3f, 0.7f}) {
+            auto bsdf = build(cs);
+            bsdf->set_scalar("alpha", alpha);
+            BSDFContext ctx;
+            ctx.mode = cs.mode;
+            int n_valid = 0;
+            for (uint32_t i = 0; i < 256; ++i) {
+                float z = (i % 2 ? 1.f : -1.f) * (0.05f + 0.95f * sample_1d(51, i, 0, 0));
+                float r = std::sqrt(1.f - z * z), phi = 2.f * kPi * sample_1d(51, i, 0, 1);
+                Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
+                BSDFSample<16> bs = bsdf->sample(ctx, wi, sample_1d(51, i, 0, 2), Vec2f(sample_1d(51, i, 0, 3), sample_1d(51, i, 0, 4)));
+                if (!bs.valid()) continue;
+                ASSERT_FALSE(bs.lobe & kDelta) << cs.name;
+                ++n_valid;
+                Spectrum<16> g = bsdf->weight_grad_scalar(ctx, wi, bs, 0);
+                Spectrum<16> expect = bsdf->eval_grad_scalar(ctx, wi, bs.wo, 0) / bs.pdf;
+                EXPECT_TRUE(g.isFinite().all()) << cs.name;
+                EXPECT_LE((g - expect).abs().maxCoeff(), 1e-6f * expect.abs().maxCoeff()) << cs.name << " α " << alpha;
+            }
+            EXPECT_GT(n_valid, 64) << cs.name << " α " << alpha;
+        }
+}
+
+TEST(BSDFAlpha, SetScalarEqualsFreshConstruction) {
+    // set_scalar re-derives everything cached from alpha (roughplastic: t table, Fdr_int, ρ̃,
+    // and their α-derivatives): a BSDF moved to alpha b behaves bit for bit like one built with
+    // b, for eval, pdf, sample, both gradients; and moving back restores the original.
+    const Spectrum<16> c1 = ramp(-0.4f, 1.3f), c2 = ramp(0.9f, -0.6f);
+    for (const char* type : {"roughconductor", "roughdielectric", "roughplastic", "roughplastic nonlinear", "twosided"})
+        for (const char* d : {"beckmann", "ggx"}) {
+            auto make = [&](float alpha) {
+                std::string t = type;
+                std::shared_ptr<Props> p;
+                if (t == "twosided") p = twosided(props("roughconductor", d, alpha));
+                else p = props(t.substr(0, t.find(' ')), d, alpha);
+                if (t == "roughplastic nonlinear") p->values["nonlinear"] = true;
+                auto b = make_bsdf<16>(*p);
+                auto keys = b->spectral_keys();
+                for (size_t k = 0; k < keys.size(); ++k) b->set_spectral(keys[k], k ? c2 : c1);
+                return b;
+            };
+            auto moved = make(0.3f), fresh = make(0.55f), orig = make(0.3f);
+            const int nkeys = int(moved->spectral_keys().size());
+            auto same = [&](BSDF<16>& a, BSDF<16>& b, const char* what) {
+                for (uint32_t i = 0; i < 64; ++i) {
+                    float z = (i % 4 == 3 ? -1.f : 1.f) * (0.05f + 0.95f * sample_1d(61, i, 0, 0));
+                    float r = std::sqrt(1.f - z * z), phi = 2.f * kPi * sample_1d(61, i, 0, 1);
+                    Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
+                    Vec3f wo = sphere(sample_1d(61, i, 0, 2), sample_1d(61, i, 0, 3));
+                    float u1 = sample_1d(61, i, 0, 4);
+                    Vec2f u2(sample_1d(61, i, 0, 5), sample_1d(61, i, 0, 6));
+                    BSDFContext ctx;
+                    EXPECT_TRUE((a.eval(ctx, wi, wo) == b.eval(ctx, wi, wo)).all()) << type << " " << d << " " << what;
+                    EXPECT_EQ(a.pdf(ctx, wi, wo), b.pdf(ctx, wi, wo)) << type << " " << d << " " << what;
+                    EXPECT_TRUE((a.eval_grad_scalar(ctx, wi, wo, 0) == b.eval_grad_scalar(ctx, wi, wo, 0)).all()) << type << " " << d << " " << what;
+                    for (int k = 0; k < nkeys; ++k)
+                        EXPECT_TRUE((a.eval_grad(ctx, wi, wo, k) == b.eval_grad(ctx, wi, wo, k)).all()) << type << " " << d << " " << what;
+                    BSDFSample<16> sa = a.sample(ctx, wi, u1, u2), sb = b.sample(ctx, wi, u1, u2);
+                    EXPECT_EQ(sa.pdf, sb.pdf) << type << " " << d << " " << what;
+                    EXPECT_EQ(sa.wo, sb.wo) << type << " " << d << " " << what;
+                    EXPECT_TRUE((sa.weight == sb.weight).all()) << type << " " << d << " " << what;
+                    if (sa.valid()) {
+                        EXPECT_TRUE((a.weight_grad_scalar(ctx, wi, sa, 0) == b.weight_grad_scalar(ctx, wi, sb, 0)).all()) << type << " " << d;
+                    }
+                }
+            };
+            moved->set_scalar("alpha", 0.55f);
+            same(*moved, *fresh, "moved to 0.55");
+            moved->set_scalar("alpha", 0.3f);
+            same(*moved, *orig, "moved back to 0.3");
+        }
+}
+
+TEST(BSDFAlpha, KeysRoundTripClampAndErrors) {
+    for (const char* type : {"roughconductor", "roughdielectric", "roughplastic", "twosided"})
+        for (const char* d : {"beckmann", "ggx"}) {
+            std::string t = type;
+            auto p = t == "twosided" ? twosided(props("roughplastic", d, 0.25f)) : props(t, d, 0.25f);
+            auto bsdf = make_bsdf<16>(*p);
+            ASSERT_EQ(bsdf->scalar_keys(), std::vector<std::string>{"alpha"}) << type;
+            EXPECT_EQ(bsdf->get_scalar("alpha"), 0.25f) << type;
+            for (float v : {0.37f, 0.9f, 1.7f, 1e-4f, 2e-4f}) {
+                bsdf->set_scalar("alpha", v);
+                EXPECT_EQ(bsdf->get_scalar("alpha"), v) << type;
+            }
+            for (float v : {5e-5f, 1e-6f, 0.f, -0.f, -2.f}) {  // the constructor's minimum
+                bsdf->set_scalar("alpha", v);
+                EXPECT_EQ(bsdf->get_scalar("alpha"), 1e-4f) << type << " " << v;
+            }
+            bsdf->set_scalar("alpha", 0.4f);
+            EXPECT_THROW(bsdf->set_scalar("alpha", std::nanf("")), std::invalid_argument) << type;
+            EXPECT_THROW(bsdf->set_scalar("alpha", INFINITY), std::invalid_argument) << type;
+            EXPECT_EQ(bsdf->get_scalar("alpha"), 0.4f) << type << ": a rejected value changes nothing";
+            EXPECT_THROW(bsdf->get_scalar("roughness"), std::invalid_argument) << type;
+            EXPECT_THROW(bsdf->set_scalar("alpha_u", 0.3f), std::invalid_argument) << type;
+            EXPECT_THROW(bsdf->eval_grad_scalar(BSDFContext{}, Vec3f(0, 0, 1), Vec3f(0, 0, 1), 1), std::invalid_argument) << type;
+            EXPECT_EQ(bsdf->get_scalar("alpha"), 0.4f) << type;
+            // The constructor's clamp is the same.
+            auto tiny = t == "twosided" ? twosided(props("roughplastic", d, 1e-6f)) : props(t, d, 1e-6f);
+            EXPECT_EQ(make_bsdf<16>(*tiny)->get_scalar("alpha"), 1e-4f) << type;
+        }
+    // BSDFs without roughness expose no scalar parameter (diffuse is left to its own tests).
+    for (const char* type : {"conductor", "dielectric", "plastic"}) {
+        auto bsdf = make_bsdf<16>(*props(type));
+        EXPECT_TRUE(bsdf->scalar_keys().empty()) << type;
+        EXPECT_THROW(bsdf->get_scalar("alpha"), std::invalid_argument) << type;
+        EXPECT_THROW(bsdf->set_scalar("alpha", 0.3f), std::invalid_argument) << type;
+    }
+    EXPECT_TRUE(make_bsdf<16>(*twosided(props("conductor")))->scalar_keys().empty());
+}
+
+TEST(BSDFAlpha, GradientsFiniteOverTheWholeRange) {
+    // From the clamp (1e-4: D ~ 3e7 at the peak) to alpha > 1, at the mirror direction (the
+    // peak), its neighbours, sampled directions and random ones.
+    const Spectrum<16> c1 = ramp(-0.4f, 1.3f);
+    for (const char* type : {"roughconductor", "roughdielectric", "roughplastic"})
+        for (const char* d : {"beckmann", "ggx"})
+            for (float alpha : {1e-4f, 1e-3f, 0.02f, 1.f, 2.5f}) {
+                auto bsdf = make_bsdf<16>(*props(type, d, alpha));
+                bsdf->set_spectral(bsdf->spectral_keys()[0], c1);
+                for (uint32_t i = 0; i < 128; ++i) {
+                    float z = (i % 2 ? 1.f : -1.f) * (0.01f + 0.99f * sample_1d(71, i, 0, 0));
+                    float r = std::sqrt(1.f - z * z), phi = 2.f * kPi * sample_1d(71, i, 0, 1);
+                    Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
+                    Vec3f mirror(-wi.x(), -wi.y(), wi.z());
+                    for (const Vec3f& wo : {mirror, Vec3f((mirror + Vec3f(1e-3f, 0.f, 0.f)).normalized()), Vec3f(-wi),
+                                            sphere(sample_1d(71, i, 0, 2), sample_1d(71, i, 0, 3))})
+                        EXPECT_TRUE(bsdf->eval_grad_scalar(BSDFContext{}, wi, wo, 0).isFinite().all()) << type << " " << d << " " << alpha;
+                    BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, sample_1d(71, i, 0, 4), Vec2f(sample_1d(71, i, 0, 5), sample_1d(71, i, 0, 6)));
+                    if (bs.valid()) {
+                        EXPECT_TRUE(bsdf->weight_grad_scalar(BSDFContext{}, wi, bs, 0).isFinite().all()) << type << " " << d << " " << alpha;
+                    }
+                }
+            }
+}
