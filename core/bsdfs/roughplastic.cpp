@@ -20,8 +20,10 @@
 // Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28), (34), (36)-(39), (42)-(43).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
+#include "core/texture.h"
 #include "core/bsdfs/microfacet.h"
 #include "core/warp.h"
+#include <optional>
 #include <algorithm>
 #include <array>
 
@@ -36,16 +38,20 @@ public:
     explicit RoughPlastic(const Props& props)
         : m_distr(read_distribution(props), read_alpha(props)),
           m_eta(read_relative_ior(props, 1.49f, 1.000277f, true)),
-          m_diffuse(spectrum_from_rgb<N>(props.get_rgb("diffuse_reflectance", Eigen::Array3f::Constant(0.5f)))),
+          m_diffuse(spectrum_from_rgb<N>(diffuse_texture(props).mean())),
           m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))) {
         m_inv_eta2 = 1.f / (m_eta * m_eta);
+        if constexpr (N == 3) {
+            Texture tex = diffuse_texture(props);
+            if (!tex.is_constant()) m_texture = std::move(tex);
+        }
         m_nonlinear = props.get_bool("nonlinear", false);
         rebuild();
     }
 
     std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
-        if (key == "diffuse_reflectance") m_diffuse = v, update_base();
+        if (key == "diffuse_reflectance") m_diffuse = v, m_texture.reset(), update_base();
         else if (key == "specular_reflectance") m_specular = v;
         else BSDF<N>::set_spectral(key, v);
     }
@@ -67,14 +73,14 @@ public:
         if (m_distr.alpha() != old) rebuild();  // the tables depend on alpha only
     }
 
-    Spectrum<N> eval(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
+    Spectrum<N> eval(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const override {
         float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
         Vec3f h = (wi + wo).normalized();
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);  // docs/bsdfs.md (25)
         if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
         float diff = m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o;
-        return m_specular * spec + m_base * diff;
+        return m_specular * spec + base(ctx) * diff;
     }
 
     float pdf(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -112,7 +118,11 @@ public:
     }
 
     uint32_t flags() const override { return kGlossyReflection | kDiffuseReflection; }
-    Spectrum<N> albedo(const BSDFContext&) const override { return m_diffuse; }
+    Spectrum<N> albedo(const BSDFContext& ctx) const override {
+        if constexpr (N == 3)
+            if (m_texture) return m_texture->eval(ctx.uv);
+        return m_diffuse;
+    }
 
     /// ∂(f·|cos wo|)/∂c, docs/bsdfs.md (36). Key 0 (diffuse_reflectance): the diffuse term of
     /// (25) with ρ̃ replaced by ∂ρ̃/∂ρ from (34): a constant for nonlinear = false, but
@@ -163,6 +173,21 @@ private:
     }
 
     // ρ̃, ∂ρ̃/∂ρ and ∂ρ̃/∂α (through Fdr_int), docs/bsdfs.md (25), (34), (42).
+    /// A textured diffuse_reflectance (N = 3 only; latent channels use the image's mean, which
+    /// set_spectral replaces; latent textures are issue 7).
+    static Texture diffuse_texture(const Props& props) {
+        return texture_from_props(props, "diffuse_reflectance", Eigen::Array3f::Constant(0.5f));
+    }
+    /// The base colour at this lookup: docs/bsdfs.md (23) applied to the texel for textures.
+    Spectrum<N> base(const BSDFContext& ctx) const {
+        if constexpr (N == 3)
+            if (m_texture) {
+                Spectrum<N> d = m_texture->eval(ctx.uv);
+                return m_nonlinear ? Spectrum<N>(d / (1.f - d * m_fdr_int)) : Spectrum<N>(d / (1.f - m_fdr_int));
+            }
+        return m_base;
+    }
+
     void update_base() {
         if (m_nonlinear) {
             Spectrum<N> denom = 1.f - m_diffuse * m_fdr_int;
@@ -254,6 +279,7 @@ private:
     MicrofacetDistribution m_distr;
     float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f, m_dfdr_int = 0.f;
     bool m_nonlinear = false;
+    std::optional<Texture> m_texture;  ///< only ever set for N = 3
     Spectrum<N> m_diffuse, m_specular, m_base, m_base_grad, m_base_dalpha;
     std::array<float, kTableRes> m_table{}, m_dtable{};  ///< t(mu_j) and ∂t/∂α(mu_j)
 };

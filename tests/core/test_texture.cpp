@@ -310,3 +310,29 @@ TEST(Texture, JsonSceneResolvesFilenamesAndNamesUnsupportedUses) {
     expect_has(err, "materials.wood.specular_reflectance");
     expect_has(err, "textured specular_reflectance on conductor is not supported yet");
 }
+
+TEST(Texture, PlasticsWithBitmapDiffuseEqualTheConstantAtThatTexel) {
+    // A textured plastic at uv must equal the same plastic with the texel's colour as a constant.
+    const Vec3f wi = Vec3f(0.3f, 0.1f, 1.f).normalized(), wo = Vec3f(-0.2f, 0.4f, 1.f).normalized();
+    for (const char* type : {"plastic", "roughplastic"})
+        for (bool nonlinear : {false, true}) {
+            Props tex;
+            tex.type = type;
+            tex.values["diffuse_reflectance"] = bitmap_props(write_quad_exr());
+            tex.values["nonlinear"] = nonlinear;
+            Props flat = tex;
+            flat.values["diffuse_reflectance"] = Eigen::Array3f(kRed);
+            auto a = make_bsdf<3>(tex), b = make_bsdf<3>(flat);
+            BSDFContext ctx;
+            ctx.uv = Vec2f(0.25f, 0.25f);  // the red texel, as in DiffuseWithBitmapReflectance
+            expect_rgb(a->eval(ctx, wi, wo), b->eval(ctx, wi, wo));
+            expect_rgb(a->albedo(ctx), b->albedo(ctx));
+            for (float u1 : {0.1f, 0.9f}) {
+                BSDFSample<3> sa = a->sample(ctx, wi, u1, Vec2f(0.3f, 0.7f)), sb = b->sample(ctx, wi, u1, Vec2f(0.3f, 0.7f));
+                ASSERT_EQ(sa.valid(), sb.valid());
+                if (sa.valid()) expect_rgb(sa.weight, sb.weight);
+            }
+            ctx.uv = Vec2f(0.75f, 0.75f);  // another texel: must differ from the red constant
+            EXPECT_FALSE(a->eval(ctx, wi, wo).isApprox(b->eval(ctx, wi, wo), 1e-3f)) << type;
+        }
+}
