@@ -37,7 +37,9 @@ public:
     }
 
     void begin(int tile, size_t n) override {
-        Scratch& s = m_scratch.local();
+        // One lookup per wavefront: every hook until end() runs on this thread (path_observer.h).
+        t_current = &m_scratch.local();
+        Scratch& s = *t_current;
         s.tile = tile;
         if (s.paths.size() < n) s.paths.resize(n);
         for (size_t i = 0; i < n; ++i) s.paths[i].events.clear();
@@ -59,7 +61,7 @@ public:
         push(slot, e);
     }
     void light_sample(uint32_t slot, int shadow_id, int shape, int emitter, const L& beta, float w_over_pdf, const BSDFContext& ctx,
-                      const Vec3f& wi, const Vec3f& wo, bool nee, bool first) override {
+                      const Vec3f& wi, const Vec3f& wo, const L& f, bool nee, bool first) override {
         Event e;
         e.type = Event::Light;
         e.shape = shape;
@@ -71,12 +73,12 @@ public:
         e.visible = false;
         if (nee) {
             const BSDF<kLatentChannels>& bsdf = m_model.spectra().bsdf_of(m_model.scene(), shape);
-            e.local = bsdf.eval(ctx, wi, wo) * w_over_pdf;
+            e.local = f * w_over_pdf;
             const auto& keys = m_model.slots(shape).bsdf;
             for (size_t k = 0; k < keys.size() && k < kMaxKeys; ++k) e.grad[k] = bsdf.eval_grad(ctx, wi, wo, int(k)) * w_over_pdf;
             if (!m_model.slots(shape).scalar.empty()) e.sgrad = bsdf.eval_grad_scalar(ctx, wi, wo, 0) * w_over_pdf;
         }
-        Scratch& s = m_scratch.local();
+        Scratch& s = *t_current;
         if (shadow_id >= 0) {
             if (s.pending.size() <= size_t(shadow_id)) s.pending.resize(shadow_id + 1);
             s.pending[shadow_id] = {slot, s.paths[slot].events.size()};
@@ -84,7 +86,7 @@ public:
         push(slot, e);
     }
     void shadow(int shadow_id, bool blocked) override {
-        Scratch& s = m_scratch.local();
+        Scratch& s = *t_current;
         auto [slot, idx] = s.pending[shadow_id];
         s.paths[slot].events[idx].visible = !blocked;
     }
@@ -105,7 +107,7 @@ public:
 
     /// docs/path-replay.md (2)–(5): reverse sweep per path.
     void end(const uint32_t* pixel, size_t n) override {
-        Scratch& s = m_scratch.local();
+        Scratch& s = *t_current;
         std::vector<float>& g = m_tile_grads[s.tile];
         const ParamStore& ps = m_model.params();
         const auto& terms = m_model.terms();
@@ -186,14 +188,17 @@ private:
         return m_model.slots(m_model.scene().emitters[emitter].shape).Le;
     }
 
-    void push(uint32_t slot, const Event& e) { m_scratch.local().paths[slot].events.push_back(e); }
+    void push(uint32_t slot, const Event& e) { t_current->paths[slot].events.push_back(e); }
 
     LatentModel& m_model;
     const std::vector<float>& m_d_image;
     float m_inv_spp;
     std::vector<std::vector<float>> m_tile_grads;
     tbb::enumerable_thread_specific<Scratch> m_scratch;
+    static thread_local Scratch* t_current;
 };
+
+thread_local Adjoint::Scratch* Adjoint::t_current = nullptr;
 
 }  // namespace
 

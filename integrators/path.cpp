@@ -193,7 +193,7 @@ private:
             const bool gate_shadowed = m_terms && m_terms->gate == OcclusionGate::Shadowed;
             if (m_scene.lights.empty()) {  // no light: everything is in shadow
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
-                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
+                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], Spectrum<N>::Zero(), false, true);
                 continue;
             }
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
@@ -204,7 +204,7 @@ private:
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
             if (!ls.valid() || sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f) {
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
-                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
+                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], Spectrum<N>::Zero(), false, true);
                 continue;
             }
             Spectrum<N> contribution = Spectrum<N>::Zero();
@@ -212,9 +212,10 @@ private:
             ctx.uv = sq.uv[k];
             const Vec3f wo = sq.frame[k].to_local(ls.wi);
             float w_over_pdf = 0.f;
+            Spectrum<N> f = Spectrum<N>::Zero();
             if (nee) {
                 const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
-                Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
+                f = bsdf.eval(ctx, sq.wi[k], wo);
                 // A zero f (a latent reflectance at 0) still has a derivative: keep it for the adjoint.
                 if ((f != 0.f).any() || m_obs) {
                     float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
@@ -236,7 +237,7 @@ private:
                 dir = d / dist;
                 tmax = dist * (1.f - 1e-4f);
             }
-            if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, p.beta[slot], w_over_pdf, ctx, sq.wi[k], wo, nee, first);
+            if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, p.beta[slot], w_over_pdf, ctx, sq.wi[k], wo, f, nee, first);
             ws.shadow.rays.push(o, dir, 0.f, tmax);
             ws.shadow.slot.push_back(slot);
             ws.shadow.contribution.push_back(contribution);

@@ -21,11 +21,12 @@ public:
     virtual void emission(uint32_t slot, int emitter, const Spectrum<N>& beta, float mis) = 0;
     /// Ĩa: beta · L̃a(shape) at the first non-delta vertex, or beta · background (shape = -1).
     virtual void ambient(uint32_t slot, int shape, const Spectrum<N>& beta) = 0;
-    /// A light sample at a vertex of `shape`: NEE (if `nee`: beta · f(wi, wo) · L̃e · w_over_pdf)
-    /// and/or Ĩc's gate (if `first`). shadow_id indexes this depth's shadow rays, or is -1 when
-    /// no ray was traced because V = 0 is known (attached shadow, no light).
+    /// A light sample at a vertex of `shape`: NEE (if `nee`: beta · f · L̃e · w_over_pdf, with
+    /// f = f(wi, wo)·|cos| as the tracer evaluated it) and/or Ĩc's gate (if `first`). shadow_id
+    /// indexes this depth's shadow rays, or is -1 when no ray was traced because V = 0 is known
+    /// (attached shadow, no light).
     virtual void light_sample(uint32_t slot, int shadow_id, int shape, int emitter, const Spectrum<N>& beta, float w_over_pdf,
-                              const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, bool nee, bool first) = 0;
+                              const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, const Spectrum<N>& f, bool nee, bool first) = 0;
     /// The shadow ray `shadow_id` of the current depth was blocked or not.
     virtual void shadow(int shadow_id, bool blocked) = 0;
     /// BSDF sampling continued the path from a vertex of `shape`: next beta = beta · bs.weight / q.
