@@ -15,7 +15,7 @@
 // Equations: docs/bsdfs.md (1), (4), (22)-(24), (34)-(35).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
-#include "core/texture.h"
+#include "core/bsdfs/plastic_substrate.h"
 #include "core/warp.h"
 #include <optional>
 
@@ -27,22 +27,15 @@ class SmoothPlastic final : public BSDF<N> {
 public:
     explicit SmoothPlastic(const Props& props)
         : m_eta(read_relative_ior(props, 1.49f, 1.000277f, false)),
-          m_diffuse(spectrum_from_rgb<N>(diffuse_texture(props).mean())),
-          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
-          m_nonlinear(props.get_bool("nonlinear", false)) {
+          m_substrate(props),
+          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))) {
         m_inv_eta2 = 1.f / (m_eta * m_eta);
-        m_fdr_int = fresnel_diffuse_reflectance(1.f / m_eta);
-        if constexpr (N == 3) {
-            Texture tex = diffuse_texture(props);
-            if (!tex.is_constant()) m_texture = std::move(tex);
-        }
-        // docs/bsdfs.md (23): the base colour after internal bounces, an infinite geometric series.
-        update_base();
+        m_substrate.set_internal_reflectance(fresnel_diffuse_reflectance(1.f / m_eta));
     }
 
     std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
-        if (key == "diffuse_reflectance") m_diffuse = v, m_texture.reset(), update_base();
+        if (key == "diffuse_reflectance") m_substrate.set_colour(v);
         else if (key == "specular_reflectance") m_specular = v;
         else BSDF<N>::set_spectral(key, v);
     }
@@ -51,7 +44,7 @@ public:
         if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
         float t_i = 1.f - fresnel_dielectric(cos_theta(wi), m_eta).R;
         float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
-        return base(ctx) * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));  // docs/bsdfs.md (23)
+        return m_substrate.base(ctx) * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));  // docs/bsdfs.md (23)
     }
 
     float pdf(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -78,16 +71,12 @@ public:
         bs.wo = wo;
         bs.pdf = pdf;
         bs.lobe = kDiffuseReflection;
-        bs.weight = base(ctx) * (m_inv_eta2 * t_o);  // (23) / (24): t_i and cos/pi cancel
+        bs.weight = m_substrate.base(ctx) * (m_inv_eta2 * t_o);  // (23) / (24): t_i and cos/pi cancel
         return bs;
     }
 
     uint32_t flags() const override { return kDeltaReflection | kDiffuseReflection; }
-    Spectrum<N> albedo(const BSDFContext& ctx) const override {
-        if constexpr (N == 3)
-            if (m_texture) return m_texture->eval(ctx.uv);
-        return m_diffuse;
-    }
+    Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_substrate.albedo(ctx); }
 
     /// ∂(f·|cos wo|)/∂c over the diffuse lobe, docs/bsdfs.md (35). Key 0 (diffuse_reflectance):
     /// (23) with ρ̃ replaced by ∂ρ̃/∂ρ from (34), which is a constant for nonlinear = false but
@@ -98,7 +87,7 @@ public:
         if (key != 0 || cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
         float t_i = 1.f - fresnel_dielectric(cos_theta(wi), m_eta).R;
         float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
-        return m_base_grad * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));
+        return m_substrate.d_base_d_colour() * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));
     }
     /// ∂(bs.weight)/∂c, docs/bsdfs.md (35): the delta sample's weight is specular_reflectance
     /// (22), so 1 for key 1 and 0 for key 0; the diffuse sample's closed-form weight ρ̃ (1 − R_o)/η²
@@ -107,41 +96,13 @@ public:
         if (bs.lobe == kDeltaReflection) return Spectrum<N>::Constant(key == 1 ? 1.f : 0.f);
         if (key != 0) return Spectrum<N>::Zero();
         float t_o = 1.f - fresnel_dielectric(cos_theta(bs.wo), m_eta).R;
-        return m_base_grad * (m_inv_eta2 * t_o);
+        return m_substrate.d_base_d_colour() * (m_inv_eta2 * t_o);
     }
 
 private:
-    // ρ̃ and ∂ρ̃/∂ρ, docs/bsdfs.md (23), (34).
-    /// A textured diffuse_reflectance (N = 3 only; latent channels use the image's mean, which
-    /// set_spectral replaces; latent textures are issue 7).
-    static Texture diffuse_texture(const Props& props) {
-        return texture_from_props(props, "diffuse_reflectance", Eigen::Array3f::Constant(0.5f));
-    }
-    /// The base colour at this lookup: docs/bsdfs.md (23) applied to the texel for textures.
-    Spectrum<N> base(const BSDFContext& ctx) const {
-        if constexpr (N == 3)
-            if (m_texture) {
-                Spectrum<N> d = m_texture->eval(ctx.uv);
-                return m_nonlinear ? Spectrum<N>(d / (1.f - d * m_fdr_int)) : Spectrum<N>(d / (1.f - m_fdr_int));
-            }
-        return m_base;
-    }
-
-    void update_base() {
-        if (m_nonlinear) {
-            Spectrum<N> denom = 1.f - m_diffuse * m_fdr_int;
-            m_base = m_diffuse / denom;
-            m_base_grad = 1.f / (denom * denom);
-        } else {
-            m_base = m_diffuse / (1.f - m_fdr_int);
-            m_base_grad = Spectrum<N>::Constant(1.f / (1.f - m_fdr_int));
-        }
-    }
-
-    float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f;
-    std::optional<Texture> m_texture;  ///< only ever set for N = 3
-    Spectrum<N> m_diffuse, m_specular, m_base, m_base_grad;
-    bool m_nonlinear;
+    float m_eta, m_inv_eta2 = 1.f;
+    PlasticSubstrate<N> m_substrate;  ///< ρ̃ after internal bounces, docs/bsdfs.md (23)
+    Spectrum<N> m_specular;
 };
 
 }  // namespace

@@ -20,7 +20,7 @@
 // Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28), (34), (36)-(39), (42)-(43).
 #include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
-#include "core/texture.h"
+#include "core/bsdfs/plastic_substrate.h"
 #include "core/bsdfs/microfacet.h"
 #include "core/warp.h"
 #include <optional>
@@ -38,20 +38,15 @@ public:
     explicit RoughPlastic(const Props& props)
         : m_distr(read_distribution(props), read_alpha(props)),
           m_eta(read_relative_ior(props, 1.49f, 1.000277f, true)),
-          m_diffuse(spectrum_from_rgb<N>(diffuse_texture(props).mean())),
+          m_substrate(props),
           m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))) {
         m_inv_eta2 = 1.f / (m_eta * m_eta);
-        if constexpr (N == 3) {
-            Texture tex = diffuse_texture(props);
-            if (!tex.is_constant()) m_texture = std::move(tex);
-        }
-        m_nonlinear = props.get_bool("nonlinear", false);
         rebuild();
     }
 
     std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
-        if (key == "diffuse_reflectance") m_diffuse = v, m_texture.reset(), update_base();
+        if (key == "diffuse_reflectance") m_substrate.set_colour(v);
         else if (key == "specular_reflectance") m_specular = v;
         else BSDF<N>::set_spectral(key, v);
     }
@@ -80,7 +75,7 @@ public:
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);  // docs/bsdfs.md (25)
         if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
         float diff = m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o;
-        return m_specular * spec + base(ctx) * diff;
+        return m_specular * spec + m_substrate.base(ctx) * diff;
     }
 
     float pdf(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -118,11 +113,7 @@ public:
     }
 
     uint32_t flags() const override { return kGlossyReflection | kDiffuseReflection; }
-    Spectrum<N> albedo(const BSDFContext& ctx) const override {
-        if constexpr (N == 3)
-            if (m_texture) return m_texture->eval(ctx.uv);
-        return m_diffuse;
-    }
+    Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_substrate.albedo(ctx); }
 
     /// ∂(f·|cos wo|)/∂c, docs/bsdfs.md (36). Key 0 (diffuse_reflectance): the diffuse term of
     /// (25) with ρ̃ replaced by ∂ρ̃/∂ρ from (34): a constant for nonlinear = false, but
@@ -134,7 +125,7 @@ public:
         float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
         if (key == 0)
-            return m_base_grad * (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
+            return m_substrate.d_base_d_colour() * (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
         Vec3f h = (wi + wo).normalized();
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);
         if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
@@ -160,46 +151,17 @@ public:
         float t_i = transmittance(cos_i), t_o = transmittance(cos_o);
         float dt_i = interpolate(m_dtable, cos_i), dt_o = interpolate(m_dtable, cos_o);
         float k = m_inv_eta2 * kInvPi * cos_o;
-        return m_specular * dspec + m_base_dalpha * (k * t_i * t_o) + m_base * (k * (dt_i * t_o + t_i * dt_o));
+        return m_specular * dspec + m_substrate.d_base_d_alpha() * (k * t_i * t_o) + m_substrate.base_constant() * (k * (dt_i * t_o + t_i * dt_o));
     }
 
 private:
     // Everything derived from alpha: t and ∂t/∂α (26), Fdr_int and its α-derivative (27), ρ̃.
     void rebuild() {
         auto [mean_t, dmean_t] = build_table();
-        m_fdr_int = 1.f - mean_t * m_inv_eta2;  // docs/bsdfs.md (27)
-        m_dfdr_int = -dmean_t * m_inv_eta2;     // docs/bsdfs.md (42)
-        update_base();
+        // docs/bsdfs.md (27), (42)
+        m_substrate.set_internal_reflectance(1.f - mean_t * m_inv_eta2, -dmean_t * m_inv_eta2);
     }
 
-    // ρ̃, ∂ρ̃/∂ρ and ∂ρ̃/∂α (through Fdr_int), docs/bsdfs.md (25), (34), (42).
-    /// A textured diffuse_reflectance (N = 3 only; latent channels use the image's mean, which
-    /// set_spectral replaces; latent textures are issue 7).
-    static Texture diffuse_texture(const Props& props) {
-        return texture_from_props(props, "diffuse_reflectance", Eigen::Array3f::Constant(0.5f));
-    }
-    /// The base colour at this lookup: docs/bsdfs.md (23) applied to the texel for textures.
-    Spectrum<N> base(const BSDFContext& ctx) const {
-        if constexpr (N == 3)
-            if (m_texture) {
-                Spectrum<N> d = m_texture->eval(ctx.uv);
-                return m_nonlinear ? Spectrum<N>(d / (1.f - d * m_fdr_int)) : Spectrum<N>(d / (1.f - m_fdr_int));
-            }
-        return m_base;
-    }
-
-    void update_base() {
-        if (m_nonlinear) {
-            Spectrum<N> denom = 1.f - m_diffuse * m_fdr_int;
-            m_base = m_diffuse / denom;
-            m_base_grad = 1.f / (denom * denom);
-            m_base_dalpha = m_diffuse * m_diffuse * m_dfdr_int / (denom * denom);
-        } else {
-            m_base = m_diffuse / (1.f - m_fdr_int);
-            m_base_grad = Spectrum<N>::Constant(1.f / (1.f - m_fdr_int));
-            m_base_dalpha = m_diffuse * (m_dfdr_int / ((1.f - m_fdr_int) * (1.f - m_fdr_int)));
-        }
-    }
 
     // Linear interpolation over mu = j / (kTableRes - 1), as Mitsuba's lerp_gather.
     static float interpolate(const std::array<float, kTableRes>& table, float mu) {
@@ -277,10 +239,9 @@ private:
     }
 
     MicrofacetDistribution m_distr;
-    float m_eta, m_inv_eta2 = 1.f, m_fdr_int = 0.f, m_dfdr_int = 0.f;
-    bool m_nonlinear = false;
-    std::optional<Texture> m_texture;  ///< only ever set for N = 3
-    Spectrum<N> m_diffuse, m_specular, m_base, m_base_grad, m_base_dalpha;
+    float m_eta, m_inv_eta2 = 1.f;
+    PlasticSubstrate<N> m_substrate;  ///< ρ̃ after internal bounces, docs/bsdfs.md (23)
+    Spectrum<N> m_specular;
     std::array<float, kTableRes> m_table{}, m_dtable{};  ///< t(mu_j) and ∂t/∂α(mu_j)
 };
 
