@@ -30,6 +30,25 @@ void write_oiio(const std::string& path, const OIIO::ImageSpec& spec, const void
     }
     fs::rename(tmp, path);
 }
+/// EXR keeps channels in name order, so latent channels "C0".."C15" written by other tools come
+/// back as C0, C1, C10, ..., C15, C2, ...: put channels named C<number> in numeric order.
+void reorder_numbered_channels(Image& img) {
+    std::vector<std::pair<long, int>> order;
+    for (int c = 0; c < img.channels; ++c) {
+        const std::string& n = img.channel_names[c];
+        if (n.size() < 2 || n[0] != 'C' || n.find_first_not_of("0123456789", 1) != std::string::npos) return;
+        order.emplace_back(std::stol(n.substr(1)), c);
+    }
+    std::stable_sort(order.begin(), order.end());
+    std::vector<float> data(img.data.size());
+    std::vector<std::string> names(img.channels);
+    for (int c = 0; c < img.channels; ++c) {
+        names[c] = img.channel_names[order[c].second];
+        for (size_t i = 0; i < size_t(img.width) * img.height; ++i) data[i * img.channels + c] = img.data[i * img.channels + order[c].second];
+    }
+    img.data = std::move(data);
+    img.channel_names = std::move(names);
+}
 }  // namespace
 
 float linear_to_srgb(float v) {
@@ -43,22 +62,34 @@ void write_exr(const std::string& path, const Image& img) {
         spec.channelnames = img.channel_names;
     } else if (img.channels > 4) {
         spec.channelnames.clear();
-        for (int c = 0; c < img.channels; ++c) spec.channelnames.push_back("C" + std::to_string(c));
+        // Zero-padded: EXR stores channels sorted by name, and C10 would come before C2.
+        for (int c = 0; c < img.channels; ++c) spec.channelnames.push_back((c < 10 ? "C0" : "C") + std::to_string(c));
     }
     spec.attribute("compression", "zip");
     write_oiio(path, spec, img.data.data());
 }
 
-void write_png_srgb(const std::string& path, const Image& img, float exposure) {
+namespace {
+template <typename Encode>
+void write_png8(const std::string& path, const Image& img, Encode encode) {
     std::vector<uint8_t> px(size_t(img.width) * img.height * 3);
-    float scale = std::exp2(exposure);
     for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
         for (int c = 0; c < 3; ++c) {
-            float v = img.data[i * img.channels + std::min(c, img.channels - 1)] * scale;
-            px[i * 3 + c] = uint8_t(std::lround(255.f * linear_to_srgb(std::isfinite(v) ? v : 0.f)));
+            float v = img.data[i * img.channels + std::min(c, img.channels - 1)];
+            px[i * 3 + c] = uint8_t(std::lround(255.f * encode(std::isfinite(v) ? v : 0.f)));
         }
     OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
     write_oiio(path, spec, px.data());
+}
+}  // namespace
+
+void write_png_srgb(const std::string& path, const Image& img, float exposure) {
+    const float scale = std::exp2(exposure);
+    write_png8(path, img, [scale](float v) { return linear_to_srgb(v * scale); });
+}
+
+void write_png_display(const std::string& path, const Image& img) {
+    write_png8(path, img, [](float v) { return std::clamp(v, 0.f, 1.f); });
 }
 
 Image read_image(const std::string& path) {
@@ -73,6 +104,7 @@ Image read_image(const std::string& path) {
     img.data.resize(size_t(img.width) * img.height * img.channels);
     if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.data.data()))
         throw std::runtime_error(path + ": cannot decode image: " + in->geterror());
+    reorder_numbered_channels(img);
     return img;
 }
 

@@ -17,6 +17,9 @@ struct Image {
 void write_exr(const std::string& path, const Image& img);
 /// 8-bit sRGB PNG preview of the first 3 channels: linear values × 2^exposure, clamped, sRGB OETF.
 void write_png_srgb(const std::string& path, const Image& img, float exposure = 0.f);
+/// 8-bit PNG of the first 3 channels taken as display values in [0, 1] (clamped, no curve):
+/// for images that are already display-encoded, e.g. VAE outputs.
+void write_png_display(const std::string& path, const Image& img);
 /// Any format OIIO reads; throws std::runtime_error naming the file on failure.
 Image read_image(const std::string& path);
 /// Writes `contents` to path atomically (temp + rename).
