@@ -49,8 +49,29 @@ struct FitArgs {
     std::string tone = "clip", param = "code", gate = "shadowed", terms = "eac";
     bool resume = false, quiet = false;
     std::map<std::string, std::string> defines;
+    bool encode = false;          ///< target = VAE encoding of an RGB path trace of the scene
+    std::string encode_res = "256x256";  ///< image resolution for --encode (latent = image / 8)
+    int ref_spp = 256;
+    std::string ref_tone = "clip";       ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
+    std::string vae_dir;                 ///< default: <shared>/models/taesd3
 };
 int run_fit(const FitArgs& args);
+
+struct VaeArgs {
+    std::string input, out, vae_dir;
+    bool quiet = false;
+};
+int run_encode(const VaeArgs& args);
+int run_decode(const VaeArgs& args);
+int run_viz(const VaeArgs& args);
+
+/// ../shared (LATENTPT_SHARED overrides) + "/models/taesd3" unless `dir` is given.
+std::string default_vae_dir(const std::string& dir);
+/// Path-traced RGB of `scene_path` at width x height, tone-mapped as the paper does for its
+/// references (clip or reinhard, then gamma 1/2.2), encoded by the VAE in `vae_dir`.
+std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,
+                                     int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
+                                     const std::string& save_png);
 
 /// Parses "WxH"; throws std::invalid_argument with a clear message.
 void parse_resolution(const std::string& s, int& w, int& h);

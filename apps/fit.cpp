@@ -70,6 +70,14 @@ int run_fit(const FitArgs& a) {
     std::vector<float> target;
     if (!a.target.empty()) {
         target = load_target(a.target, w, h);
+    } else if (a.encode) {
+        // The paper's target: path-traced RGB, tone-mapped, encoded by the VAE (TAESD3).
+        int iw = 0, ih = 0;
+        parse_resolution(a.encode_res, iw, ih);
+        target = encoded_reference(a.scene, a.defines, iw, ih, a.ref_spp, a.ref_tone, a.vae_dir, a.quiet, (fs::path(a.out) / "reference.png").string());
+        w = iw / 8;
+        h = ih / 8;
+        write_latent((fs::path(a.out) / "target.exr").string(), w, h, target);
     } else {
         // A target the latent renderer makes itself from random parameters: for trying the fit
         // without a VAE, and the test suite's convergence check.
@@ -133,6 +141,14 @@ int run_fit(const FitArgs& a) {
     write_png_srgb((out / "render.png").string(), latent_grid(toned.data(), w, h, kLatentChannels, scale));
     write_png_srgb((out / "diff.png").string(), latent_grid(diff.data(), w, h, kLatentChannels, scale));
     double final_loss = huber_loss(toned.data(), target.data(), toned.size(), 1.f, nullptr);
+    if (a.encode) {
+        // What a person looks at: the fitted latent decoded to RGB next to the reference.
+        VaeArgs d{(out / "latent.exr").string(), (out / "decoded.png").string(), a.vae_dir, true};
+        run_decode(d);
+        d.input = (out / "target.exr").string();
+        d.out = (out / "target_decoded.png").string();
+        run_decode(d);
+    }
     if (!a.quiet) std::cerr << "wrote " << a.out << "/{params.json, latent*.exr, loss.csv, target|render|diff.png}; Huber loss at " << a.final_spp << " spp: " << final_loss << "\n";
     return 0;
 }

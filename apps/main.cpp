@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> fit_defines;
     auto* fit = app.add_subcommand("fit", "fit per-shape latent parameters to a target latent map (stage 1)");
     fit->add_option("scene", f.scene, "scene file (.json or Mitsuba 3 .xml)")->required()->check(CLI::ExistingFile);
-    fit->add_option("--target", f.target, "16-channel float EXR at latent resolution (channels C0..C15); "
+    fit->add_option("--target", f.target, "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
                                           "without it, a synthetic target rendered from random parameters")->check(CLI::ExistingFile);
     fit->add_option("-o,--out", f.out, "output folder")->capture_default_str();
     fit->add_option("--synthetic-res", f.synthetic_res, "latent resolution WxH of the synthetic target")->capture_default_str();
@@ -65,8 +65,24 @@ int main(int argc, char** argv) {
     fit->add_option("--terms", f.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
     fit->add_option("--checkpoint-every", f.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();
     fit->add_flag("--resume", f.resume, "continue from <out>/checkpoint");
+    fit->add_flag("--encode", f.encode, "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
+    fit->add_option("--encode-res", f.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")->capture_default_str();
+    fit->add_option("--ref-spp", f.ref_spp, "samples per pixel of the RGB reference for --encode")->capture_default_str();
+    fit->add_option("--ref-tone", f.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
+    fit->add_option("--vae-dir", f.vae_dir, "folder with <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
     fit->add_option("-D,--define", fit_defines, "override a scene value (as for render)");
     fit->add_flag("-q,--quiet", f.quiet, "no progress line");
+
+    VaeArgs v;
+    auto* encode = app.add_subcommand("encode", "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR (TAESD3)");
+    auto* decode = app.add_subcommand("decode", "latent EXR -> RGB image (PNG, or EXR unclamped)");
+    auto* viz = app.add_subcommand("viz", "latent EXR -> PNG of its channels (green positive, red negative)");
+    for (auto* sc : {encode, decode, viz}) {
+        sc->add_option("input", v.input, "input file")->required()->check(CLI::ExistingFile);
+        sc->add_option("-o,--out", v.out, "output file")->required();
+        sc->add_flag("-q,--quiet", v.quiet, "no messages");
+    }
+    for (auto* sc : {encode, decode}) sc->add_option("--vae-dir", v.vae_dir, "VAE weights folder (default: ../shared/models/taesd3)");
 
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
@@ -81,6 +97,9 @@ int main(int argc, char** argv) {
             return run_render(r);
         }
         if (*bench) return b.fit ? run_bench_fit(b) : run_bench(b);
+        if (*encode) return run_encode(v);
+        if (*decode) return run_decode(v);
+        if (*viz) return run_viz(v);
         if (*fit) {
             for (const auto& d : fit_defines) {
                 auto eq = d.find('=');
