@@ -7,9 +7,11 @@ bash scripts/install-deps.sh
 bash scripts/build.sh
 mkdir -p demo-out
 ./build/apps/latentpt render scenes/cornell-box/scene.json --spp 64 --res 256x256 --aov --out demo-out/cornell-box.exr
-# Stage 1 of latent rendering on a synthetic target (random latent parameters rendered by the
-# latent renderer itself) until the VAE lands: reduced iterations, about ten seconds.
-./build/apps/latentpt fit scenes/cornell-box/scene.json --synthetic-res 32x32 --iterations 600 --spp 4 --lr 0.05 \
-    --lr-period 600 --final-spp 64 -D integrator.max_depth=4 --out demo-out/fit
-echo "demo: open demo-out/cornell-box.png (RGB render), demo-out/fit/{target,render,diff}.png (16 latent channels:"
-echo "      green positive, red negative), demo-out/fit/loss.csv and params.json"
+# Stage 1 of latent rendering, the paper's way: path trace the box in RGB, encode it with TAESD3
+# (weights from ../shared, or LATENTPT_SHARED), fit the per-shape latent parameters, decode.
+# Reduced iterations: about ten seconds.
+./build/apps/latentpt fit scenes/cornell-box/scene.json --encode --encode-res 256x256 --ref-spp 256 \
+    --iterations 600 --spp 4 --lr 0.05 --lr-period 600 --final-spp 64 -D integrator.max_depth=4 --out demo-out/fit
+echo "demo: demo-out/cornell-box.png is the RGB render; in demo-out/fit/: reference.png (RGB target),"
+echo "      target_decoded.png (TAESD3 round trip), decoded.png (fitted latent rendering, decoded),"
+echo "      target.png / render.png / diff.png (16 latent channels: green +, red -), loss.csv, params.json"

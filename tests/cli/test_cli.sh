@@ -33,5 +33,20 @@ expect_error "WxH" "$bin" render "$scene" --res 12 -q --out "$out/x.exr"
 expect_error "--terms" "$bin" fit "$scene" --terms xyz -q --out "$out/bad"
 expect_error "checkpoint" "$bin" fit "$scene" --resume -q --out "$out/never-fitted"
 
+shared="${LATENTPT_SHARED:-$src/../shared}"
+if [ -d "$shared/models/taesd3" ]; then
+    "$bin" render "$scene" --spp 1 --res 20x12 -q --out "$out/odd.exr"
+    expect_error "not a multiple of 8" "$bin" encode "$out/odd.png" -q --out "$out/bad.exr"
+    "$bin" render "$scene" --spp 2 --res 32x16 -q --out "$out/e.exr"
+    "$bin" encode "$out/e.png" -q --out "$out/lat.exr"; check test -s "$out/lat.exr"
+    check test "$("$bin" decode "$out/lat.exr" -q --out "$out/dec.png" && oiiotool --info "$out/dec.png" | grep -c '32 x   16')" -eq 1
+    "$bin" viz "$out/lat.exr" -q --out "$out/viz.png"; check test -s "$out/viz.png"
+    expect_error "channels" "$bin" decode "$out/r.exr" -q --out "$out/x.png"
+    "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q --out "$out/enc"
+    for f in reference.png target.exr target_decoded.png decoded.png; do check test -s "$out/enc/$f"; done
+else
+    echo "skipping VAE command checks: $shared/models/taesd3 not found (set LATENTPT_SHARED)"
+fi
+
 echo "$passed passed, $fail failed"
 [ $fail -eq 0 ]
