@@ -6,6 +6,10 @@
 #include <string>
 #include <vector>
 
+namespace lpt {
+class Scene;
+}
+
 namespace lpt::app {
 
 struct RenderArgs {
@@ -21,8 +25,12 @@ struct RenderArgs {
     float exposure = 0.f;
     std::map<std::string, std::string> defines;
     bool quiet = false;
+    std::string edit;             ///< edits.json, when `scene` is a fit folder
+    bool reference = false;       ///< also path trace + encode each edited frame, write metrics.csv
+    int ref_spp = 256;
 };
 int run_render(const RenderArgs& args);
+int run_render_edit(const RenderArgs& args);
 
 struct BenchArgs {
     std::string scene;            ///< empty = the bundled Cornell box
@@ -72,6 +80,9 @@ std::string default_vae_dir(const std::string& dir);
 std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,
                                      int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
                                      const std::string& save_png);
+/// The same for a scene already in memory (an edited frame).
+std::vector<float> encoded_reference_of(const lpt::Scene& scene, int width, int height, int spp, const std::string& tone,
+                                        const std::string& vae_dir, bool quiet, const std::string& save_png);
 
 /// Parses "WxH"; throws std::invalid_argument with a clear message.
 void parse_resolution(const std::string& s, int& w, int& h);

@@ -6,6 +6,7 @@
 #include "autodiff/loss.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
+#include <nlohmann/json.hpp>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -130,6 +131,11 @@ int run_fit(const FitArgs& a) {
     for (size_t i = 0; i < toned.size(); ++i) diff[i] = toned[i] - target[i];
     const fs::path out(a.out);
     write_text_atomic((out / "params.json").string(), model.params().to_json());
+    // Everything `latentpt render <fitdir> --edit` needs to rebuild this model.
+    nlohmann::json manifest = {{"scene", fs::absolute(a.scene).string()}, {"defines", a.defines}, {"param", a.param}, {"gate", a.gate},
+                               {"terms", a.terms}, {"tone", a.tone}, {"latent_width", w}, {"latent_height", h}, {"seed", a.seed},
+                               {"vae_dir", default_vae_dir(a.vae_dir)}, {"ref_tone", a.ref_tone}};
+    write_text_atomic((out / "fit.json").string(), manifest.dump(2));
     write_latent((out / "latent.exr").string(), w, h, toned);
     write_latent((out / "latent_e.exr").string(), w, h, films.e.develop());
     write_latent((out / "latent_a.exr").string(), w, h, films.a.develop());

@@ -15,7 +15,11 @@ int main(int argc, char** argv) {
     RenderArgs r;
     std::vector<std::string> defines;
     auto* render = app.add_subcommand("render", "path trace a scene (.json) to a float EXR plus an sRGB PNG preview");
-    render->add_option("scene", r.scene, "scene file (.json)")->required()->check(CLI::ExistingFile);
+    render->add_option("scene", r.scene, "scene file (.json or Mitsuba 3 .xml), or a fit folder with --edit")->required()->check(CLI::ExistingPath);
+    render->add_option("--edit", r.edit, "edits.json: render the fitted latent scene edited (camera, shapes), frame by frame, and decode")
+        ->check(CLI::ExistingFile);
+    render->add_flag("--reference", r.reference, "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv");
+    render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")->capture_default_str();
     render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
     render->add_option("--spp", r.spp, "samples per pixel (default: the scene's)");
     render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");
@@ -94,6 +98,7 @@ int main(int argc, char** argv) {
                 if (eq == std::string::npos) throw std::invalid_argument("-D expects key=value, got '" + d + "'");
                 r.defines[d.substr(0, eq)] = d.substr(eq + 1);
             }
+            if (!r.edit.empty()) return run_render_edit(r);
             return run_render(r);
         }
         if (*bench) return b.fit ? run_bench_fit(b) : run_bench(b);

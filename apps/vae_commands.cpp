@@ -44,12 +44,10 @@ std::vector<float> rgb_of(const Image& img, const std::string& path) {
 
 }  // namespace
 
-std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,
-                                     int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
-                                     const std::string& save_png) {
-    if (width % 8 || height % 8) throw std::invalid_argument("--encode-res must be a multiple of 8 in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const std::string& vae_dir,
+                                        bool quiet, const std::string& save_png) {
+    if (width % 8 || height % 8) throw std::invalid_argument("reference resolution must be a multiple of 8 in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
     auto vae = load_taesd(default_vae_dir(vae_dir));
-    Scene scene = load_scene(scene_path, defines);
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions o = RenderOptions::from_scene(scene);
     o.width = width;
@@ -62,6 +60,13 @@ std::vector<float> encoded_reference(const std::string& scene_path, const std::m
     if (!quiet) std::cerr << "reference: " << width << "x" << height << " at " << spp << " spp in " << st.seconds << " s\n";
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
     return vae->encode(rgb, width, height);
+}
+
+std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,
+                                     int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
+                                     const std::string& save_png) {
+    Scene scene = load_scene(scene_path, defines);
+    return encoded_reference_of(scene, width, height, spp, tone, vae_dir, quiet, save_png);
 }
 
 int run_encode(const VaeArgs& a) {

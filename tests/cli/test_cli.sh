@@ -44,6 +44,17 @@ if [ -d "$shared/models/taesd3" ]; then
     expect_error "channels" "$bin" decode "$out/r.exr" -q --out "$out/x.png"
     "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q --out "$out/enc"
     for f in reference.png target.exr target_decoded.png decoded.png; do check test -s "$out/enc/$f"; done
+    # An identity edit reproduces the fit's final latent exactly (same seed and spp).
+    printf '{"frames": 1}' > "$out/identity.json"
+    "$bin" render "$out/enc" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed"
+    check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
+    check test -s "$out/ed/frame_0000.png"
+    printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move.json"
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --out "$out/ed2"
+    check test "$(wc -l < "$out/ed2/metrics.csv")" -eq 3
+    printf '{"shapes": [{"id": "nope"}]}' > "$out/bad.json"
+    expect_error "nope" "$bin" render "$out/enc" --edit "$out/bad.json" -q --out "$out/ed3"
+    expect_error "fit.json" "$bin" render "$out" --edit "$out/identity.json" -q --out "$out/ed4"
 else
     echo "skipping VAE command checks: $shared/models/taesd3 not found (set LATENTPT_SHARED)"
 fi

@@ -1,0 +1,88 @@
+// Edit sequences: keyframe interpolation, transforms about the pivot, camera orbit geometry,
+// frames that do not accumulate, and errors naming the edits file and field.
+#include "core/error.h"
+#include "core/scene_edit.h"
+#include "core/scene_loader.h"
+#include "test_util.h"
+#include <gtest/gtest.h>
+
+using namespace lpt;
+
+namespace {
+Scene cornell() { return load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json"); }
+Vec3f centroid(const TriangleMesh& m) {
+    Vec3f c = Vec3f::Zero();
+    for (const Vec3f& p : m.positions) c += p;
+    return c / float(m.positions.size());
+}
+std::string edit_error(const Scene& s, const std::string& json) {
+    try {
+        load_edits(test::write_temp_file("edits.json", json), s);
+    } catch (const SceneError& e) {
+        return e.what();
+    }
+    return "";
+}
+}  // namespace
+
+TEST(SceneEdit, KeyframesInterpolateLinearly) {
+    Track t{{Vec3f(0, 0, 0), Vec3f(2, 0, 0), Vec3f(2, 4, 0)}};
+    EXPECT_TRUE(t.at(0.f).isApprox(Vec3f(0, 0, 0)));
+    EXPECT_TRUE(t.at(0.25f).isApprox(Vec3f(1, 0, 0)));
+    EXPECT_TRUE(t.at(0.75f).isApprox(Vec3f(2, 2, 0)));
+    EXPECT_TRUE(t.at(1.f).isApprox(Vec3f(2, 4, 0)));
+    EXPECT_TRUE(Track{{Vec3f(3, 3, 3)}}.at(0.6f).isApprox(Vec3f(3, 3, 3)));
+}
+
+TEST(SceneEdit, ShapesMoveAboutTheirCentreAndFramesDoNotAccumulate) {
+    Scene s = cornell();
+    std::vector<TriangleMesh> original;
+    for (const Shape& sh : s.shapes) original.push_back(sh.mesh);
+    const Camera cam = s.camera;
+    EditSequence e = load_edits(test::write_temp_file("e1.json", R"({"frames": 2, "shapes": [
+        {"id": "light", "translate": [[0, 0, 0], [1, 0, 0]]},
+        {"id": "tall_block", "rotate": {"axis": [0, 1, 0], "angle": [0, 90]}, "scale": 2}]})"), s);
+    const int light = s.find_shape("light"), tall = s.find_shape("tall_block");
+    const Vec3f c_light = centroid(original[light]);
+    const float area_tall = s.shapes[tall].area();
+    for (int rep = 0; rep < 2; ++rep) {  // the same t twice: no accumulation
+        apply_edits(e, 0.5f, original, cam, s);
+        EXPECT_TRUE(centroid(s.shapes[light].mesh).isApprox(c_light + Vec3f(0.5f, 0, 0), 1e-5f));
+        EXPECT_NEAR(s.shapes[tall].area(), 4.f * area_tall, 1e-3f * area_tall);  // scale 2: area x 4
+    }
+    // About the pivot (the original bounding-box centre): p -> c + R(45 deg) * 2 * (p - c).
+    Eigen::AlignedBox3f box;
+    for (const Vec3f& p : original[tall].positions) box.extend(p);
+    const Vec3f c = box.center();
+    const Eigen::Matrix3f r = Eigen::AngleAxisf(kPi / 4, Vec3f::UnitY()).toRotationMatrix();
+    for (size_t k = 0; k < original[tall].positions.size(); ++k)
+        EXPECT_LT((s.shapes[tall].mesh.positions[k] - (c + r * (2.f * (original[tall].positions[k] - c)))).norm(), 1e-4f) << k;
+    apply_edits(e, 0.f, original, cam, s);
+    EXPECT_EQ(s.shapes[light].mesh.positions, original[light].positions);
+}
+
+TEST(SceneEdit, OrbitKeepsDistanceToPivotAndTurnsByTheAngle) {
+    Scene s = cornell();
+    std::vector<TriangleMesh> original;
+    for (const Shape& sh : s.shapes) original.push_back(sh.mesh);
+    const Camera cam = s.camera;
+    EditSequence e = load_edits(test::write_temp_file("e2.json", R"({"camera": {"orbit": {"azimuth": 90, "pivot": [2.78, 2.73, 2.8]}}})"), s);
+    apply_edits(e, 0.f, original, cam, s);
+    const Vec3f pivot(2.78f, 2.73f, 2.8f);
+    const Vec3f o0 = cam.world_from_camera.point(Vec3f::Zero()), o1 = s.camera.world_from_camera.point(Vec3f::Zero());
+    EXPECT_NEAR((o0 - pivot).norm(), (o1 - pivot).norm(), 1e-4f);
+    EXPECT_NEAR((o0 - pivot).normalized().dot((o1 - pivot).normalized()), 0.f, 1e-5f);  // 90 degrees
+}
+
+TEST(SceneEdit, ErrorsNameFileAndField) {
+    Scene s = cornell();
+    std::string err = edit_error(s, R"({"shapes": [{"id": "teapot", "translate": [1, 0, 0]}]})");
+    EXPECT_NE(err.find("edits.json"), std::string::npos) << err;
+    EXPECT_NE(err.find("shapes[0].id"), std::string::npos) << err;
+    EXPECT_NE(err.find("teapot"), std::string::npos) << err;
+    EXPECT_NE(edit_error(s, R"({"shapes": [{"id": "light", "translate": [1, 0]}]})").find("shapes[0].translate"), std::string::npos);
+    EXPECT_NE(edit_error(s, R"({"shapes": [{"id": "light", "spin": 3}]})").find("shapes[0].spin"), std::string::npos);
+    EXPECT_NE(edit_error(s, R"({"frames": 0})").find("frames"), std::string::npos);
+    EXPECT_NE(edit_error(s, R"({"camera": {"zoom": 2}})").find("camera"), std::string::npos);
+    EXPECT_NE(edit_error(s, R"({"frames": )").find("malformed"), std::string::npos);
+}
