@@ -73,6 +73,9 @@ int run_encode(const VaeArgs& args);
 int run_decode(const VaeArgs& args);
 int run_viz(const VaeArgs& args);
 
+struct MetricsArgs { std::string a, b, vae_dir; bool json = false; };
+int run_metrics(const MetricsArgs&);
+
 /// ../shared (LATENTPT_SHARED overrides) + "/models/taesd3" unless `dir` is given.
 std::string default_vae_dir(const std::string& dir);
 /// Path-traced RGB of `scene_path` at width x height, tone-mapped as the paper does for its

@@ -88,6 +88,14 @@ int main(int argc, char** argv) {
     }
     for (auto* sc : {encode, decode}) sc->add_option("--vae-dir", v.vae_dir, "VAE weights folder (default: ../shared/models/taesd3)");
 
+    MetricsArgs m;
+    auto* metrics = app.add_subcommand("metrics", "MSE, PSNR, SSIM and LPIPS between two images (PNG display values or linear EXR), "
+                                                  "or MSE, PSNR and SSIM between two 16-channel latent EXRs");
+    metrics->add_option("a", m.a, "first image or latent EXR")->required()->check(CLI::ExistingFile);
+    metrics->add_option("b", m.b, "second image or latent EXR, same size and kind")->required()->check(CLI::ExistingFile);
+    metrics->add_option("--lpips-dir", m.vae_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
+    metrics->add_flag("--json", m.json, "print one JSON object instead of text");
+
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
@@ -105,6 +113,7 @@ int main(int argc, char** argv) {
         if (*encode) return run_encode(v);
         if (*decode) return run_decode(v);
         if (*viz) return run_viz(v);
+        if (*metrics) return run_metrics(m);
         if (*fit) {
             for (const auto& d : fit_defines) {
                 auto eq = d.find('=');
