@@ -1,6 +1,7 @@
 // Beckmann and GGX microfacet distributions. Equations: docs/bsdfs.md (5)-(12); roughness
 // derivatives (37)-(39).
 #include "core/bsdfs/microfacet.h"
+#include <stdexcept>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -10,7 +11,11 @@ namespace lpt {
 MicrofacetDistribution::MicrofacetDistribution(MicrofacetType type, float alpha)
     : m_type(type), m_alpha(std::max(alpha, kMinAlpha)) {}
 
-void MicrofacetDistribution::set_alpha(float alpha) { m_alpha = std::max(alpha, kMinAlpha); }
+void MicrofacetDistribution::set_alpha(float alpha) {
+    // A fit step must never leave a NaN roughness behind: every rough plugin relies on this.
+    if (!std::isfinite(alpha)) throw std::invalid_argument("microfacet roughness alpha must be finite");
+    m_alpha = std::max(alpha, kMinAlpha);
+}
 
 float MicrofacetDistribution::D(const Vec3f& m) const {
     float c2 = m.z() * m.z();

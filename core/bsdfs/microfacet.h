@@ -27,6 +27,7 @@ public:
     MicrofacetType type() const { return m_type; }
     float alpha() const { return m_alpha; }
     /// Replaces alpha, raised to kMinAlpha as in the constructor.
+    /// Raised to kMinAlpha; throws std::invalid_argument if not finite.
     void set_alpha(float alpha);
 
     /// Normal distribution D(m), normalised so that ∫ D(m) cos(theta_m) dm = 1; 0 for m.z <= 0.

@@ -88,7 +88,6 @@ public:
     /// caches alpha. Non-finite values throw std::invalid_argument.
     void set_scalar(const std::string& key, float value) override {
         if (key != "alpha") BSDF<N>::set_scalar(key, value);
-        if (!std::isfinite(value)) throw std::invalid_argument("roughconductor: alpha must be finite");
         m_distr.set_alpha(value);
     }
     /// ∂(f·|cos wo|)/∂α = specular_reflectance · F(wi·h) (∂D G + D ∂G) / (4 cos θi),

@@ -142,7 +142,6 @@ public:
     /// caches alpha. Non-finite values throw std::invalid_argument.
     void set_scalar(const std::string& key, float value) override {
         if (key != "alpha") BSDF<N>::set_scalar(key, value);
-        if (!std::isfinite(value)) throw std::invalid_argument("roughdielectric: alpha must be finite");
         m_distr.set_alpha(value);
     }
     /// ∂(f·|cos wo|)/∂α, docs/bsdfs.md (41): (19) and (20) with D G replaced by

@@ -62,7 +62,6 @@ public:
     /// Non-finite values throw std::invalid_argument.
     void set_scalar(const std::string& key, float value) override {
         if (key != "alpha") BSDF<N>::set_scalar(key, value);
-        if (!std::isfinite(value)) throw std::invalid_argument("roughplastic: alpha must be finite");
         float old = m_distr.alpha();
         m_distr.set_alpha(value);
         if (m_distr.alpha() != old) rebuild();  // the tables depend on alpha only
