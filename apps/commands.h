@@ -84,8 +84,10 @@ std::vector<float> encoded_reference(const std::string& scene_path, const std::m
                                      int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
                                      const std::string& save_png);
 /// The same for a scene already in memory (an edited frame).
+/// `display_rgb`, if given, receives the tone-mapped RGB that was encoded.
 std::vector<float> encoded_reference_of(const lpt::Scene& scene, int width, int height, int spp, const std::string& tone,
-                                        const std::string& vae_dir, bool quiet, const std::string& save_png);
+                                        const std::string& vae_dir, bool quiet, const std::string& save_png,
+                                        std::vector<float>* display_rgb = nullptr);
 
 /// Parses "WxH"; throws std::invalid_argument with a clear message.
 void parse_resolution(const std::string& s, int& w, int& h);

@@ -7,6 +7,10 @@
 #include "core/image_io.h"
 #include "core/scene_edit.h"
 #include "core/scene_loader.h"
+#include "vae/lpips.h"
+#include "vae/ssim.h"
+#include "vae/vae.h"
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <cmath>
 #include <cstdio>
@@ -62,7 +66,16 @@ int run_render_edit(const RenderArgs& a) {
     const fs::path out(a.out.empty() || a.out == "render.exr" ? "edit-out" : a.out);
     fs::create_directories(out);
     std::ostringstream csv;
-    csv << "frame,t,latent_mse,latent_psnr\n";
+    csv << "frame,t,latent_mse,latent_psnr,rgb_ssim,rgb_lpips\n";
+    // Image metrics of the decoded frame against the decoded-space reference (docs/metrics.md).
+    std::unique_ptr<Vae> vae;
+    std::unique_ptr<Lpips> lpips;
+    if (a.reference && have_vae) {
+        vae = load_taesd(vae_dir);
+        const fs::path lpips_dir = fs::path(vae_dir).parent_path() / "lpips";
+        if (fs::exists(lpips_dir)) lpips = Lpips::load(lpips_dir.string());
+        else if (!a.quiet) std::cerr << "note: no LPIPS weights at " << lpips_dir.string() << ": rgb_lpips left empty\n";
+    }
     for (int i = 0; i < edits.frames; ++i) {
         const float t = float(i) / float(edits.frames);
         apply_edits(edits, t, original, original_camera, scene);
@@ -81,12 +94,21 @@ int run_render_edit(const RenderArgs& a) {
         }
         if (a.reference) {
             // The edited scene file is not on disk: path trace this Scene directly.
+            std::vector<float> ref_rgb;
             std::vector<float> ref = encoded_reference_of(scene, 8 * w, 8 * h, a.ref_spp, m.value("ref_tone", "clip"), vae_dir, true,
-                                                          (out / (std::string(name) + "_reference.png")).string());
+                                                          (out / (std::string(name) + "_reference.png")).string(), &ref_rgb);
             double mse = 0;
             for (size_t k = 0; k < ref.size(); ++k) mse += double(latent[k] - ref[k]) * (latent[k] - ref[k]);
             mse /= double(ref.size());
-            csv << i << "," << t << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12)) << "\n";  // data range 6 (±3)
+            csv << i << "," << t << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12));  // data range 6 (±3)
+            std::string s_ssim, s_lpips;
+            if (vae) {
+                std::vector<float> rgb = vae->decode(latent, w, h);
+                for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+                if (8 * w >= 11 && 8 * h >= 11) s_ssim = std::to_string(ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0));
+                if (lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) s_lpips = std::to_string(lpips->distance(rgb, ref_rgb, 8 * w, 8 * h));
+            }
+            csv << "," << s_ssim << "," << s_lpips << "\n";
         }
         if (!a.quiet) std::fprintf(stderr, "\r[edit] frame %d/%d   ", i + 1, edits.frames);
     }

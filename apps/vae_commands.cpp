@@ -45,7 +45,7 @@ std::vector<float> rgb_of(const Image& img, const std::string& path) {
 }  // namespace
 
 std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const std::string& vae_dir,
-                                        bool quiet, const std::string& save_png) {
+                                        bool quiet, const std::string& save_png, std::vector<float>* display_rgb) {
     if (width % 8 || height % 8) throw std::invalid_argument("reference resolution must be a multiple of 8 in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
     auto vae = load_taesd(default_vae_dir(vae_dir));
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
@@ -59,6 +59,7 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
     for (float& v : rgb) v = display(v, tone);
     if (!quiet) std::cerr << "reference: " << width << "x" << height << " at " << spp << " spp in " << st.seconds << " s\n";
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
+    if (display_rgb) *display_rgb = rgb;
     return vae->encode(rgb, width, height);
 }
 

@@ -52,6 +52,7 @@ if [ -d "$shared/models/taesd3" ]; then
     printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move.json"
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --out "$out/ed2"
     check test "$(wc -l < "$out/ed2/metrics.csv")" -eq 3
+    check grep -q "rgb_ssim,rgb_lpips" "$out/ed2/metrics.csv"
     printf '{"shapes": [{"id": "nope"}]}' > "$out/bad.json"
     expect_error "nope" "$bin" render "$out/enc" --edit "$out/bad.json" -q --out "$out/ed3"
     expect_error "fit.json" "$bin" render "$out" --edit "$out/identity.json" -q --out "$out/ed4"
