@@ -25,14 +25,6 @@ RenderOptions iteration_options(const LatentModel& model, const FitOptions& o, i
     return r;
 }
 
-std::string read_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path + ": cannot open checkpoint file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 }  // namespace
 
 std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone) {

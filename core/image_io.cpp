@@ -1,4 +1,6 @@
 #include "core/image_io.h"
+#include "core/error.h"
+#include <sstream>
 #include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <cmath>
@@ -106,6 +108,14 @@ Image read_image(const std::string& path) {
         throw std::runtime_error(path + ": cannot decode image: " + in->geterror());
     reorder_numbered_channels(img);
     return img;
+}
+
+std::string read_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw SceneError(path, "", "cannot open file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
 }
 
 void write_text_atomic(const std::string& path, const std::string& contents) {

@@ -22,6 +22,8 @@ void write_png_srgb(const std::string& path, const Image& img, float exposure = 
 void write_png_display(const std::string& path, const Image& img);
 /// Any format OIIO reads; throws std::runtime_error naming the file on failure.
 Image read_image(const std::string& path);
+/// The whole file as bytes; throws SceneError(path, "", "cannot open file") if it cannot be read.
+std::string read_file(const std::string& path);
 /// Writes `contents` to path atomically (temp + rename).
 void write_text_atomic(const std::string& path, const std::string& contents);
 

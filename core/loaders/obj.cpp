@@ -12,6 +12,7 @@
 //    the file, and a relative index reaching before the first vertex resolves to a negative one.
 // Its warnings are otherwise ignored: they are about materials or are covered by the checks.
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/mesh.h"
 #include <tiny_obj_loader.h>
 #include <cctype>
@@ -24,14 +25,6 @@
 
 namespace lpt {
 namespace {
-
-std::string read_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw SceneError(path, "", "cannot open file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 std::vector<std::string> split_ws(const std::string& line) {
     std::vector<std::string> out;

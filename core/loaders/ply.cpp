@@ -5,6 +5,7 @@
 // vertex_index with integer types); every other element and property is skipped by its declared
 // type, so files with colours, tristrips or custom data still load. Polygons are fan-triangulated.
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/mesh.h"
 #include <algorithm>
 #include <cctype>
@@ -204,14 +205,6 @@ int find_prop(const PlyElement& e, const char* name) {
     for (size_t i = 0; i < e.props.size(); ++i)
         if (e.props[i].name == name) return int(i);
     return -1;
-}
-
-std::string read_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw SceneError(path, "", "cannot open file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
 }
 
 }  // namespace
