@@ -4,7 +4,7 @@
 // nearest 2x upsampling, and a 3·tanh(x/3) soft clamp at the decoder input. Weights are BF16
 // safetensors converted to float32 by our reader (vae/safetensors.h).
 #include "vae/safetensors.h"
-#include "vae/vae.h"
+#include "vae/vae_torch.h"
 #include <torch/torch.h>
 #include <algorithm>
 #include <stdexcept>
@@ -55,7 +55,7 @@ torch::Tensor block(const Weights& w, int i, const torch::Tensor& x) {
     return torch::relu(conv(w, p + "4", y) + x);
 }
 
-class Taesd final : public Vae {
+class Taesd final : public Vae, public TorchVae {
 public:
     Taesd(const std::string& dir, const std::string& prefix, const LatentConvention& conv) : m_conv(conv) {
         std::vector<std::pair<std::string, std::vector<int64_t>>> enc, dec;
@@ -83,15 +83,7 @@ public:
                                         std::to_string(f) + " in both axes (crop or pad it first)");
         if (rgb.size() != size_t(width) * height * 3) throw std::invalid_argument("encode: expected width*height*3 floats");
         torch::NoGradGuard no_grad;
-        torch::Tensor x = torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2});
-        x = conv(m_enc, "0", x);
-        x = block(m_enc, 1, x);
-        for (int i : {2, 6, 10}) {
-            x = conv(m_enc, std::to_string(i), x, 2);
-            for (int b = i + 1; b <= i + 3; ++b) x = block(m_enc, b, x);
-        }
-        x = conv(m_enc, "14", x);
-        return to_hwc(x);
+        return to_hwc(encode_nchw(torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2})));
     }
 
     std::vector<float> decode(const std::vector<float>& latent, int width, int height) const override {
@@ -100,8 +92,21 @@ public:
             throw std::invalid_argument("decode: expected " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(c) +
                                         " floats, got " + std::to_string(latent.size()));
         torch::NoGradGuard no_grad;
-        torch::Tensor x = torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c}).permute({0, 3, 1, 2});
-        x = torch::tanh(x / 3.0) * 3.0;
+        return to_hwc(decode_nchw(torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c}).permute({0, 3, 1, 2})));
+    }
+
+    torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {
+        torch::Tensor x = conv(m_enc, "0", rgb);
+        x = block(m_enc, 1, x);
+        for (int i : {2, 6, 10}) {
+            x = conv(m_enc, std::to_string(i), x, 2);
+            for (int b = i + 1; b <= i + 3; ++b) x = block(m_enc, b, x);
+        }
+        return conv(m_enc, "14", x);
+    }
+
+    torch::Tensor decode_nchw(const torch::Tensor& latent) const override {
+        torch::Tensor x = torch::tanh(latent / 3.0) * 3.0;
         x = torch::relu(conv(m_dec, "1", x));
         for (int b : {3, 4, 5}) x = block(m_dec, b, x);
         for (int i : {7, 12, 17}) {
@@ -111,8 +116,7 @@ public:
             else
                 for (int b = i + 1; b <= i + 3; ++b) x = block(m_dec, b, x);
         }
-        x = conv(m_dec, "19", x);
-        return to_hwc(x);
+        return conv(m_dec, "19", x);
     }
 
     const LatentConvention& convention() const override { return m_conv; }

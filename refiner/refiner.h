@@ -1,0 +1,91 @@
+// The per-scene refiner (stage 2 of `latentpt fit`): a small CNN that maps the rendered latent
+// plus AOVs (world shading normal, camera distance) at latent resolution to a residual that is
+// added to the rendered latent. Torch-free interface: buffers are interleaved per pixel, row-major
+// from the top-left, like films and vae.h. libtorch stays inside refiner/*.cpp. docs/refiner.md
+// gives the architecture, the loss and the measured quality/time trade-offs.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace lpt {
+
+class Vae;
+class Lpips;
+
+struct RefinerConfig {
+    int latent_channels = 16;
+    int expansion = 16;          ///< hidden width = expansion × latent_channels
+    float squash = 3.f;          ///< inputs enter as tanh(x / squash); 3 = the TAESD decoder's soft clamp
+    float dropout = 0.1f;
+    float distance_scale = 1.f;  ///< distances are divided by this (the training view's mean hit distance)
+};
+
+/// What the refiner reads for one view: the rendered (tone-mapped) latent and its AOVs.
+struct RefinerInput {
+    int width = 0, height = 0;
+    std::vector<float> latent;    ///< width × height × latent_channels
+    std::vector<float> normal;    ///< width × height × 3
+    std::vector<float> distance;  ///< width × height × 1 (0 where the camera ray escapes)
+};
+
+struct RefinerTrainOptions {
+    int iterations = 3000;
+    float lr = 5e-4f;
+    float w_mse = 1.f, w_ssim = 1.f, w_lpips = 1.f;  ///< loss = w·MSE + w·(1 − SSIM) + w·LPIPS
+    int crop = 32;        ///< latent pixels per side of the training crop; 0 = the whole view
+    int lpips_crop = 16;  ///< latent pixels per side decoded for LPIPS (8× in RGB); 0 = no LPIPS
+    int patience = 500;   ///< early stopping on the smoothed loss; 0 = off
+    float min_delta = 1e-5f;
+    uint64_t seed = 0;
+    int checkpoint_every = 100;  ///< 0 = only at the end
+    std::string checkpoint_path; ///< empty = no checkpoints
+    bool resume = false;         ///< continue from checkpoint_path
+};
+
+struct RefinerRecord {
+    int iteration = 0;
+    double loss = 0, smoothed = 0, mse = 0, dssim = 0, lpips = 0, seconds = 0;
+};
+
+struct RefinerTrainResult {
+    std::vector<RefinerRecord> history;  ///< every iteration since the start (resumed runs included)
+    int best_iteration = -1;
+    double best_loss = 0;
+};
+
+class Refiner {
+public:
+    /// A new network whose output convolution starts at zero, so it begins as the identity.
+    static std::unique_ptr<Refiner> create(const RefinerConfig& config, uint64_t seed);
+    /// Loads a file written by save(); throws std::runtime_error naming the file.
+    static std::unique_ptr<Refiner> load(const std::string& path);
+    ~Refiner();
+
+    /// Writes weights and configuration atomically (temporary file + rename).
+    void save(const std::string& path) const;
+    /// Refined latent (width × height × latent_channels) of a view of any size; deterministic.
+    std::vector<float> refine(const RefinerInput& input) const;
+
+    /// Trains on one view against `target` (latent). LPIPS compares decoded crops with
+    /// `target_rgb` (8w × 8h × 3 in [0, 1]) when given, else with the decoded target; it needs
+    /// `vae` (differentiable) and `lpips`, and is skipped when either is null. `on_iteration`
+    /// returning false stops early. Ends with the best (smoothed-loss) weights loaded.
+    RefinerTrainResult train(const RefinerInput& input, const std::vector<float>& target, const std::vector<float>* target_rgb,
+                             const Vae* vae, const Lpips* lpips, const RefinerTrainOptions& options,
+                             const std::function<bool(const RefinerRecord&)>& on_iteration = {});
+
+    const RefinerConfig& config() const;
+    /// Number of learnable weights (for reports).
+    int64_t parameter_count() const;
+
+    struct Impl;
+
+private:
+    explicit Refiner(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m;
+};
+
+}  // namespace lpt

@@ -1,0 +1,127 @@
+// Refiner network: construction, inference, and the refiner.pt file (a torch::serialize
+// archive holding the weights and the RefinerConfig, written atomically).
+#include "refiner/refiner_net.h"
+#include <algorithm>
+#include <filesystem>
+#include <stdexcept>
+#include <thread>
+
+namespace lpt {
+
+namespace {
+
+torch::nn::Conv2d conv(int64_t in, int64_t out, int64_t k) { return torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, k).padding(k / 2)); }
+
+void use_all_cores() { at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency()))); }
+
+}  // namespace
+
+RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
+    if (config.latent_channels < 1 || config.expansion < 1 || !(config.squash > 0.f) || !(config.dropout >= 0.f && config.dropout < 1.f) ||
+        !(config.distance_scale > 0.f))
+        throw std::invalid_argument("refiner: invalid configuration (channels, expansion >= 1; squash, distance scale > 0; dropout in [0, 1))");
+    const int64_t c = config.latent_channels, width = int64_t(config.expansion) * c;
+    c1 = register_module("c1", conv(c + kRefinerAovChannels, width, 3));
+    c2 = register_module("c2", conv(width, width, 5));
+    c3 = register_module("c3", conv(width, width, 3));
+    head = register_module("head", conv(width, c, 1));
+    auto norm = [&](const char* name) { return register_module(name, torch::nn::InstanceNorm2d(torch::nn::InstanceNorm2dOptions(width).affine(true))); };
+    n1 = norm("n1");
+    n2 = norm("n2");
+    n3 = norm("n3");
+    drop = register_module("drop", torch::nn::Dropout(torch::nn::DropoutOptions(config.dropout)));
+}
+
+torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x) {
+    torch::Tensor h = torch::tanh(x / cfg.squash);
+    h = drop(torch::relu(n1(c1(h))));
+    h = drop(torch::relu(n2(c2(h))));
+    h = drop(torch::relu(n3(c3(h))));
+    return x.narrow(1, 0, cfg.latent_channels) + head(h);
+}
+
+torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config) {
+    const int64_t w = in.width, h = in.height, c = config.latent_channels, n = w * h;
+    if (w < 1 || h < 1) throw std::invalid_argument("refiner: empty view");
+    if (int64_t(in.latent.size()) != n * c || int64_t(in.normal.size()) != n * 3 || int64_t(in.distance.size()) != n)
+        throw std::invalid_argument("refiner: a " + std::to_string(w) + "x" + std::to_string(h) + " view needs " + std::to_string(c) +
+                                    " latent, 3 normal and 1 distance channels per pixel");
+    auto nchw = [&](const std::vector<float>& v, int64_t ch) {
+        return torch::from_blob(const_cast<float*>(v.data()), {1, h, w, ch}).permute({0, 3, 1, 2});
+    };
+    return torch::cat({nchw(in.latent, c), nchw(in.normal, 3), nchw(in.distance, 1) / config.distance_scale}, 1).contiguous();
+}
+
+std::vector<float> refiner_to_hwc(const torch::Tensor& nchw) {
+    torch::Tensor t = nchw.permute({0, 2, 3, 1}).contiguous();
+    return std::vector<float>(t.data_ptr<float>(), t.data_ptr<float>() + t.numel());
+}
+
+Refiner::Refiner(std::unique_ptr<Impl> impl) : m(std::move(impl)) {}
+Refiner::~Refiner() = default;
+
+std::unique_ptr<Refiner> Refiner::create(const RefinerConfig& config, uint64_t seed) {
+    use_all_cores();
+    torch::manual_seed(seed);
+    auto impl = std::make_unique<Impl>(Impl{config, RefinerNet(config)});
+    // A zero head makes the untrained refiner the identity: stage 2 starts from stage 1's result.
+    torch::NoGradGuard no_grad;
+    impl->net->head->weight.zero_();
+    impl->net->head->bias.zero_();
+    return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));
+}
+
+const RefinerConfig& Refiner::config() const { return m->config; }
+
+int64_t Refiner::parameter_count() const {
+    int64_t n = 0;
+    for (const auto& p : m->net->parameters()) n += p.numel();
+    return n;
+}
+
+std::vector<float> Refiner::refine(const RefinerInput& input) const {
+    torch::NoGradGuard no_grad;
+    m->net->eval();
+    return refiner_to_hwc(m->net->forward(refiner_input_tensor(input, m->config)));
+}
+
+void Refiner::save(const std::string& path) const {
+    torch::serialize::OutputArchive ar;
+    m->net->save(ar);
+    const RefinerConfig& c = m->config;
+    ar.write("config.latent_channels", c10::IValue(int64_t(c.latent_channels)));
+    ar.write("config.expansion", c10::IValue(int64_t(c.expansion)));
+    ar.write("config.squash", c10::IValue(double(c.squash)));
+    ar.write("config.dropout", c10::IValue(double(c.dropout)));
+    ar.write("config.distance_scale", c10::IValue(double(c.distance_scale)));
+    const std::string tmp = path + ".tmp";
+    ar.save_to(tmp);
+    std::filesystem::rename(tmp, path);
+}
+
+std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
+    if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": refiner file not found");
+    use_all_cores();
+    try {
+        torch::serialize::InputArchive ar;
+        ar.load_from(path);
+        auto get = [&](const char* key) {
+            c10::IValue v;
+            if (!ar.try_read(key, v)) throw std::runtime_error(path + ": not a latentpt refiner (no '" + std::string(key) + "')");
+            return v;
+        };
+        RefinerConfig c;
+        c.latent_channels = int(get("config.latent_channels").toInt());
+        c.expansion = int(get("config.expansion").toInt());
+        c.squash = float(get("config.squash").toDouble());
+        c.dropout = float(get("config.dropout").toDouble());
+        c.distance_scale = float(get("config.distance_scale").toDouble());
+        auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
+        impl->net->load(ar);
+        return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));
+    } catch (const c10::Error& e) {
+        throw std::runtime_error(path + ": cannot read refiner: " + e.what_without_backtrace());
+    }
+}
+
+}  // namespace lpt

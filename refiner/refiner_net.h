@@ -1,0 +1,36 @@
+// The refiner's libtorch network, shared by refiner_net.cpp (build, apply, save, load) and
+// refiner_train.cpp. Internal to refiner/: include only from .cpp files there.
+#pragma once
+#include "refiner/refiner.h"
+#include <torch/torch.h>
+
+namespace lpt {
+
+/// tanh(x / squash) → [conv k, InstanceNorm, ReLU, Dropout] for k = 3, 5, 3 → 1×1 conv, and
+/// the result is added to the unsquashed latent (the first latent_channels input channels).
+struct RefinerNetImpl : torch::nn::Module {
+    explicit RefinerNetImpl(const RefinerConfig& config);
+    /// x: [N, latent_channels + 4, h, w] (latent, normal xyz, scaled distance) → refined latent.
+    torch::Tensor forward(const torch::Tensor& x);
+
+    RefinerConfig cfg;
+    torch::nn::Conv2d c1{nullptr}, c2{nullptr}, c3{nullptr}, head{nullptr};
+    torch::nn::InstanceNorm2d n1{nullptr}, n2{nullptr}, n3{nullptr};
+    torch::nn::Dropout drop{nullptr};
+};
+TORCH_MODULE(RefinerNet);
+
+struct Refiner::Impl {
+    RefinerConfig config;
+    RefinerNet net;
+};
+
+constexpr int kRefinerAovChannels = 4;  ///< normal (3) + distance (1)
+
+/// The network input [1, C + 4, h, w] of a view (distance divided by config.distance_scale).
+/// Throws std::invalid_argument on buffer sizes that do not match width × height.
+torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config);
+/// [1, C, h, w] → interleaved h × w × C floats.
+std::vector<float> refiner_to_hwc(const torch::Tensor& nchw);
+
+}  // namespace lpt
