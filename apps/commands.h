@@ -8,6 +8,7 @@
 
 namespace lpt {
 class Scene;
+struct RefinerInput;
 }
 
 namespace lpt::app {
@@ -46,6 +47,24 @@ struct BenchArgs {
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);
 
+/// Stage 2 on a fit folder: trains the refiner on the folder's final render (latent.exr, aov.exr)
+/// against target.exr (and reference_rgb.exr for LPIPS when present).
+struct RefineArgs {
+    std::string fitdir;
+    int iterations = 3000, expansion = 16, crop = 32, lpips_crop = 16, patience = 500, checkpoint_every = 100;
+    float lr = 5e-4f, w_mse = 1.f, w_ssim = 1.f, w_lpips = 1.f, squash = 3.f, dropout = 0.1f;
+    uint64_t seed = 0;
+    bool resume = false, quiet = false;
+    std::string lpips_dir;  ///< default: ../shared/models/lpips
+};
+int run_refine(const RefineArgs& args);
+/// The refiner's view of a rendered latent: AOVs (normal, distance) of `scene` at the latent's
+/// resolution, averaged over `spp` camera samples with `seed` (as the latent was rendered).
+RefinerInput refiner_view(const lpt::Scene& scene, std::vector<float> latent, int w, int h, int spp, uint64_t seed);
+/// aov.exr of a fit folder (channels N.X N.Y N.Z Z) and its reader (with latent.exr).
+void write_refiner_aovs(const std::string& path, const RefinerInput& in);
+RefinerInput load_refiner_input(const std::string& latent_exr, const std::string& aov_exr);
+
 struct FitArgs {
     std::string scene, target, out = "fit-out";
     std::string synthetic_res = "32x32";  ///< used when no --target is given
@@ -62,6 +81,8 @@ struct FitArgs {
     int ref_spp = 256;
     std::string ref_tone = "clip";       ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
     std::string vae_dir;                 ///< default: <shared>/models/taesd3
+    bool refiner = true;                 ///< run stage 2 after stage 1
+    RefineArgs refine;                   ///< stage-2 options (fitdir, seed, resume, quiet are filled in)
 };
 int run_fit(const FitArgs& args);
 
@@ -78,6 +99,8 @@ int run_metrics(const MetricsArgs&);
 
 /// ../shared (LATENTPT_SHARED overrides) + "/models/taesd3" unless `dir` is given.
 std::string default_vae_dir(const std::string& dir);
+/// ../shared (LATENTPT_SHARED overrides) + "/models/lpips" unless `dir` is given.
+std::string default_lpips_dir(const std::string& dir);
 /// Path-traced RGB of `scene_path` at width x height, tone-mapped as the paper does for its
 /// references (clip or reinhard, then gamma 1/2.2), encoded by the VAE in `vae_dir`.
 std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,

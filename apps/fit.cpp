@@ -4,8 +4,10 @@
 #include "apps/commands.h"
 #include "autodiff/fit.h"
 #include "autodiff/loss.h"
+#include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
+#include "refiner/refiner.h"
 #include <nlohmann/json.hpp>
 #include <filesystem>
 #include <iostream>
@@ -69,13 +71,19 @@ int run_fit(const FitArgs& a) {
 
     int w = 0, h = 0;
     std::vector<float> target;
+    fs::create_directories(a.out);
     if (!a.target.empty()) {
         target = load_target(a.target, w, h);
+        write_latent((fs::path(a.out) / "target.exr").string(), w, h, target);
     } else if (a.encode) {
         // The paper's target: path-traced RGB, tone-mapped, encoded by the VAE (TAESD3).
         int iw = 0, ih = 0;
         parse_resolution(a.encode_res, iw, ih);
-        target = encoded_reference(a.scene, a.defines, iw, ih, a.ref_spp, a.ref_tone, a.vae_dir, a.quiet, (fs::path(a.out) / "reference.png").string());
+        std::vector<float> ref_rgb;
+        target = encoded_reference_of(load_scene(a.scene, a.defines), iw, ih, a.ref_spp, a.ref_tone, a.vae_dir, a.quiet,
+                                      (fs::path(a.out) / "reference.png").string(), &ref_rgb);
+        // The refiner's LPIPS and metrics.json compare decoded latents with this image.
+        write_exr((fs::path(a.out) / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}});
         w = iw / 8;
         h = ih / 8;
         write_latent((fs::path(a.out) / "target.exr").string(), w, h, target);
@@ -137,6 +145,8 @@ int run_fit(const FitArgs& a) {
                                {"vae_dir", default_vae_dir(a.vae_dir)}, {"ref_tone", a.ref_tone}};
     write_text_atomic((out / "fit.json").string(), manifest.dump(2));
     write_latent((out / "latent.exr").string(), w, h, toned);
+    // AOVs of the same view with the same samples: what the refiner reads beside the latent.
+    write_refiner_aovs((out / "aov.exr").string(), refiner_view(model.scene(), toned, w, h, ro.spp, ro.seed));
     write_latent((out / "latent_e.exr").string(), w, h, films.e.develop());
     write_latent((out / "latent_a.exr").string(), w, h, films.a.develop());
     write_latent((out / "latent_c.exr").string(), w, h, films.c.develop());
@@ -155,7 +165,15 @@ int run_fit(const FitArgs& a) {
         d.out = (out / "target_decoded.png").string();
         run_decode(d);
     }
-    if (!a.quiet) std::cerr << "wrote " << a.out << "/{params.json, latent*.exr, loss.csv, target|render|diff.png}; Huber loss at " << a.final_spp << " spp: " << final_loss << "\n";
+    if (!a.quiet) std::cerr << "wrote " << a.out << "/{params.json, latent*.exr, aov.exr, loss.csv, target|render|diff.png}; Huber loss at " << a.final_spp << " spp: " << final_loss << "\n";
+    if (a.refiner) {
+        RefineArgs r = a.refine;
+        r.fitdir = a.out;
+        r.seed = a.seed;
+        r.resume = a.resume;
+        r.quiet = a.quiet;
+        return run_refine(r);
+    }
     return 0;
 }
 

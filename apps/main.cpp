@@ -75,7 +75,33 @@ int main(int argc, char** argv) {
     fit->add_option("--ref-tone", f.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
     fit->add_option("--vae-dir", f.vae_dir, "folder with <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
     fit->add_option("-D,--define", fit_defines, "override a scene value (as for render)");
+    fit->add_flag("!--no-refiner", f.refiner, "stop after stage 1 (no refiner training)");
     fit->add_flag("-q,--quiet", f.quiet, "no progress line");
+
+    // Stage-2 options: `--refiner-<name>` on fit, `--<name>` on refine.
+    auto refine_options = [](CLI::App* sc, RefineArgs& ra, const std::string& pre) {
+        sc->add_option("--" + pre + "iterations", ra.iterations, "refiner training steps")->capture_default_str();
+        sc->add_option("--" + pre + "expansion", ra.expansion, "refiner width = expansion x 16 channels")->capture_default_str();
+        sc->add_option("--" + pre + "crop", ra.crop, "latent crop side per refiner step (0 = the whole view)")->capture_default_str();
+        sc->add_option("--" + pre + "lpips-crop", ra.lpips_crop, "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")->capture_default_str();
+        sc->add_option("--" + pre + "lr", ra.lr, "refiner Adam learning rate")->capture_default_str();
+        sc->add_option("--" + pre + "patience", ra.patience, "refiner early stopping on the smoothed loss; 0 = off")->capture_default_str();
+        sc->add_option("--" + pre + "w-mse", ra.w_mse, "weight of latent MSE")->capture_default_str();
+        sc->add_option("--" + pre + "w-ssim", ra.w_ssim, "weight of latent 1 - SSIM")->capture_default_str();
+        sc->add_option("--" + pre + "w-lpips", ra.w_lpips, "weight of LPIPS on decoded crops")->capture_default_str();
+        sc->add_option("--" + pre + "squash", ra.squash, "inputs enter as tanh(x / squash)")->capture_default_str();
+        sc->add_option("--" + pre + "dropout", ra.dropout, "dropout after each block")->capture_default_str();
+        sc->add_option("--" + pre + "checkpoint-every", ra.checkpoint_every, "refiner steps between checkpoints")->capture_default_str();
+        sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
+    };
+    refine_options(fit, f.refine, "refiner-");
+    RefineArgs rf;
+    auto* refine = app.add_subcommand("refine", "train the per-scene refiner on a fit folder (stage 2; fit runs it unless --no-refiner)");
+    refine->add_option("fitdir", rf.fitdir, "folder written by latentpt fit")->required()->check(CLI::ExistingDirectory);
+    refine_options(refine, rf, "");
+    refine->add_option("--seed", rf.seed, "seed of the initial weights, crops and dropout")->capture_default_str();
+    refine->add_flag("--resume", rf.resume, "continue from <fitdir>/refiner_checkpoint.pt");
+    refine->add_flag("-q,--quiet", rf.quiet, "no progress line");
 
     VaeArgs v;
     auto* encode = app.add_subcommand("encode", "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR (TAESD3)");
@@ -114,6 +140,7 @@ int main(int argc, char** argv) {
         if (*decode) return run_decode(v);
         if (*viz) return run_viz(v);
         if (*metrics) return run_metrics(m);
+        if (*refine) return run_refine(rf);
         if (*fit) {
             for (const auto& d : fit_defines) {
                 auto eq = d.find('=');

@@ -74,12 +74,6 @@ Loaded load(const std::string& path) {
     return l;
 }
 
-std::string default_lpips_dir(const std::string& dir) {
-    if (!dir.empty()) return dir;
-    const char* env = std::getenv("LATENTPT_SHARED");
-    return (env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared") + "/models/lpips";
-}
-
 std::string json_string(const std::string& s) {
     std::string o = "\"";
     for (char c : s) {

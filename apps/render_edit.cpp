@@ -1,12 +1,14 @@
 // `latentpt render <fitdir> --edit edits.json --out outdir/`: the fitted latent scene under
 // camera/light/object edits, frame by frame: latent EXR (tone-mapped, what the VAE reads),
 // decoded PNG, and with --reference the RGB path trace of the same edit encoded by the VAE and
-// per-frame latent errors in metrics.csv. The refiner (issue 5) will add a refined latent.
+// per-frame latent errors in metrics.csv. With the fit's refiner.pt, each frame is also refined
+// (frame_NNNN_refined.exr) and frame_NNNN.png shows the refined latent decoded.
 #include "apps/commands.h"
 #include "autodiff/fit.h"
 #include "core/image_io.h"
 #include "core/scene_edit.h"
 #include "core/scene_loader.h"
+#include "refiner/refiner.h"
 #include "vae/lpips.h"
 #include "vae/ssim.h"
 #include "vae/vae.h"
@@ -65,17 +67,38 @@ int run_render_edit(const RenderArgs& a) {
 
     const fs::path out(a.out.empty() || a.out == "render.exr" ? "edit-out" : a.out);
     fs::create_directories(out);
-    std::ostringstream csv;
-    csv << "frame,t,latent_mse,latent_psnr,rgb_ssim,rgb_lpips\n";
-    // Image metrics of the decoded frame against the decoded-space reference (docs/metrics.md).
+    // Stage 2, when the fit trained one: every frame is refined from its latent and AOVs.
+    std::unique_ptr<Refiner> refiner;
+    if (fs::exists(dir / "refiner.pt")) refiner = Refiner::load((dir / "refiner.pt").string());
+    else if (!a.quiet) std::cerr << "note: " << (dir / "refiner.pt").string() << " not found: frames are not refined\n";
     std::unique_ptr<Vae> vae;
     std::unique_ptr<Lpips> lpips;
+    if (have_vae) vae = load_taesd(vae_dir);
     if (a.reference && have_vae) {
-        vae = load_taesd(vae_dir);
-        const fs::path lpips_dir = fs::path(vae_dir).parent_path() / "lpips";
-        if (fs::exists(lpips_dir)) lpips = Lpips::load(lpips_dir.string());
-        else if (!a.quiet) std::cerr << "note: no LPIPS weights at " << lpips_dir.string() << ": rgb_lpips left empty\n";
+        const std::string lpips_dir = default_lpips_dir("");
+        if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) lpips = Lpips::load(lpips_dir);
+        else if (!a.quiet) std::cerr << "note: no LPIPS weights at " << lpips_dir << ": rgb_lpips left empty\n";
     }
+    std::ostringstream csv;
+    csv << "frame,t,latent_mse,latent_psnr,rgb_ssim,rgb_lpips" << (refiner ? ",refined_latent_mse,refined_latent_psnr,refined_rgb_ssim,refined_rgb_lpips" : "") << "\n";
+    // Latent and decoded-image errors of one frame against the encoded reference (docs/metrics.md).
+    auto frame_metrics = [&](const std::vector<float>& latent, const std::vector<float>& ref, const std::vector<float>& ref_rgb) {
+        double mse = 0;
+        for (size_t k = 0; k < ref.size(); ++k) mse += double(latent[k] - ref[k]) * (latent[k] - ref[k]);
+        mse /= double(ref.size());
+        std::ostringstream o;
+        o << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12)) << ",";  // data range 6 (±3)
+        if (vae) {
+            std::vector<float> rgb = vae->decode(latent, w, h);
+            for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+            if (8 * w >= 11 && 8 * h >= 11) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
+            o << ",";
+            if (lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) o << lpips->distance(rgb, ref_rgb, 8 * w, 8 * h);
+        } else {
+            o << ",";
+        }
+        return o.str();
+    };
     for (int i = 0; i < edits.frames; ++i) {
         const float t = float(i) / float(edits.frames);
         apply_edits(edits, t, original, original_camera, scene);
@@ -84,31 +107,31 @@ int run_render_edit(const RenderArgs& a) {
         ro.height = h;
         ro.spp = a.spp > 0 ? a.spp : 64;
         ro.seed = a.seed + uint64_t(i);
-        std::vector<float> latent = render_toned(model, ro, tone);
+        std::vector<float> latent = render_toned(model, ro, tone), refined;
         char name[64];
         std::snprintf(name, sizeof name, "frame_%04d", i);
-        write_exr((out / (std::string(name) + "_latent.exr")).string(), Image{w, h, kLatentChannels, latent, {}});
-        if (have_vae) {
-            VaeArgs d{(out / (std::string(name) + "_latent.exr")).string(), (out / (std::string(name) + ".png")).string(), vae_dir, true};
-            run_decode(d);
+        const std::string stem = (out / name).string();
+        write_exr(stem + "_latent.exr", Image{w, h, kLatentChannels, latent, {}});
+        if (refiner) {
+            // Same spp and seed as the latent: an identity edit reproduces the fit's refined latent.
+            const RefinerInput view = refiner_view(scene, latent, w, h, ro.spp, ro.seed);
+            write_refiner_aovs(stem + "_aov.exr", view);
+            refined = refiner->refine(view);
+            write_exr(stem + "_refined.exr", Image{w, h, kLatentChannels, refined, {}});
+        }
+        if (vae) {
+            // frame_NNNN.png is the result (refined when there is a refiner); _rendered.png the unrefined one.
+            write_png_display(stem + (refiner ? "_rendered.png" : ".png"), Image{8 * w, 8 * h, 3, vae->decode(latent, w, h), {}});
+            if (refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, vae->decode(refined, w, h), {}});
         }
         if (a.reference) {
             // The edited scene file is not on disk: path trace this Scene directly.
             std::vector<float> ref_rgb;
             std::vector<float> ref = encoded_reference_of(scene, 8 * w, 8 * h, a.ref_spp, m.value("ref_tone", "clip"), vae_dir, true,
-                                                          (out / (std::string(name) + "_reference.png")).string(), &ref_rgb);
-            double mse = 0;
-            for (size_t k = 0; k < ref.size(); ++k) mse += double(latent[k] - ref[k]) * (latent[k] - ref[k]);
-            mse /= double(ref.size());
-            csv << i << "," << t << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12));  // data range 6 (±3)
-            std::string s_ssim, s_lpips;
-            if (vae) {
-                std::vector<float> rgb = vae->decode(latent, w, h);
-                for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
-                if (8 * w >= 11 && 8 * h >= 11) s_ssim = std::to_string(ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0));
-                if (lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) s_lpips = std::to_string(lpips->distance(rgb, ref_rgb, 8 * w, 8 * h));
-            }
-            csv << "," << s_ssim << "," << s_lpips << "\n";
+                                                          stem + "_reference.png", &ref_rgb);
+            csv << i << "," << t << frame_metrics(latent, ref, ref_rgb);
+            if (refiner) csv << frame_metrics(refined, ref, ref_rgb);
+            csv << "\n";
         }
         if (!a.quiet) std::fprintf(stderr, "\r[edit] frame %d/%d   ", i + 1, edits.frames);
     }

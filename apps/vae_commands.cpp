@@ -26,6 +26,12 @@ std::string default_vae_dir(const std::string& dir) {
     return (env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared") + "/models/taesd3";
 }
 
+std::string default_lpips_dir(const std::string& dir) {
+    if (!dir.empty()) return dir;
+    const char* env = std::getenv("LATENTPT_SHARED");
+    return (env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared") + "/models/lpips";
+}
+
 namespace {
 
 /// The paper's display mapping for references: clip to [0, 1] or |x|/(1+|x|), then x^(1/2.2).

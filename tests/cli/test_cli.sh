@@ -17,13 +17,20 @@ scene="$src/scenes/cornell-box/scene.json"
 
 "$bin" render "$scene" --spp 2 --res 24x16 --aov --aov-res 6x4 -q --out "$out/r.exr"
 check test -s "$out/r.exr"; check test -s "$out/r.png"; check test -s "$out/r.normal.exr"
-"$bin" fit "$scene" --synthetic-res 8x8 --iterations 20 --spp 2 --final-spp 4 --checkpoint-every 10 -q -D integrator.max_depth=3 --out "$out/fit"
-for f in params.json latent.exr latent_e.exr latent_a.exr latent_c.exr loss.csv target.png render.png diff.png checkpoint/state.json; do
+small_refiner="--refiner-iterations 4 --refiner-expansion 1 --refiner-checkpoint-every 2"
+"$bin" fit "$scene" --synthetic-res 8x8 --iterations 20 --spp 2 --final-spp 4 --checkpoint-every 10 -q -D integrator.max_depth=3 $small_refiner --out "$out/fit"
+for f in params.json latent.exr latent_e.exr latent_a.exr latent_c.exr aov.exr loss.csv target.png render.png diff.png checkpoint/state.json \
+         refiner.pt latent_refined.exr refiner_loss.csv metrics.json; do
     check test -s "$out/fit/$f"
 done
 check test "$(wc -l < "$out/fit/loss.csv")" -eq 21
-"$bin" fit "$scene" --synthetic-res 8x8 --iterations 30 --spp 2 --final-spp 4 -q -D integrator.max_depth=3 --out "$out/fit" --resume
+check test "$(wc -l < "$out/fit/refiner_loss.csv")" -eq 5
+"$bin" fit "$scene" --synthetic-res 8x8 --iterations 30 --spp 2 --final-spp 4 -q -D integrator.max_depth=3 --out "$out/fit" --resume --no-refiner
 check test "$(wc -l < "$out/fit/loss.csv")" -eq 31
+# Stage 2 on its own continues from its checkpoint.
+"$bin" refine "$out/fit" --iterations 6 --expansion 1 -q --resume
+check test "$(wc -l < "$out/fit/refiner_loss.csv")" -eq 7
+expect_error "latent.exr" "$bin" refine "$out" -q
 
 expect_error "channels" "$bin" fit "$scene" --target "$out/r.exr" -q --out "$out/bad"
 expect_error "does not exist" "$bin" render "$out/missing.json" -q --out "$out/x.exr"
@@ -42,17 +49,19 @@ if [ -d "$shared/models/taesd3" ]; then
     check test "$("$bin" decode "$out/lat.exr" -q --out "$out/dec.png" && oiiotool --info "$out/dec.png" | grep -c '32 x   16')" -eq 1
     "$bin" viz "$out/lat.exr" -q --out "$out/viz.png"; check test -s "$out/viz.png"
     expect_error "channels" "$bin" decode "$out/r.exr" -q --out "$out/x.png"
-    "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q --out "$out/enc"
-    for f in reference.png target.exr target_decoded.png decoded.png; do check test -s "$out/enc/$f"; done
-    # An identity edit reproduces the fit's final latent exactly (same seed and spp).
+    "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q $small_refiner --out "$out/enc"
+    for f in reference.png reference_rgb.exr target.exr target_decoded.png decoded.png decoded_refined.png metrics.json; do check test -s "$out/enc/$f"; done
+    check grep -q vae_roundtrip "$out/enc/metrics.json"
+    # An identity edit reproduces the fit's final latent and refined latent exactly (same seed and spp).
     printf '{"frames": 1}' > "$out/identity.json"
     "$bin" render "$out/enc" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed"
     check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
-    check test -s "$out/ed/frame_0000.png"
+    check oiiotool "$out/ed/frame_0000_refined.exr" "$out/enc/latent_refined.exr" --fail 0 --failpercent 0 --diff
+    check test -s "$out/ed/frame_0000.png"; check test -s "$out/ed/frame_0000_rendered.png"
     printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move.json"
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --out "$out/ed2"
     check test "$(wc -l < "$out/ed2/metrics.csv")" -eq 3
-    check grep -q "rgb_ssim,rgb_lpips" "$out/ed2/metrics.csv"
+    check grep -q "rgb_ssim,rgb_lpips,refined_latent_mse" "$out/ed2/metrics.csv"
     printf '{"shapes": [{"id": "nope"}]}' > "$out/bad.json"
     expect_error "nope" "$bin" render "$out/enc" --edit "$out/bad.json" -q --out "$out/ed3"
     expect_error "fit.json" "$bin" render "$out" --edit "$out/identity.json" -q --out "$out/ed4"
