@@ -3,15 +3,32 @@
 #pragma once
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace lpt {
 class Scene;
+class Vae;
 struct RefinerInput;
 }
 
 namespace lpt::app {
+
+/// Which autoencoder: TAESD3 weights in `dir` (native), or a TorchScript export (all three of
+/// encoder, decoder, config; tools/export_vae.py makes them for the SD3.5 VAE).
+struct VaeSource {
+    std::string dir;                       ///< empty = ../shared/models/taesd3 (LATENTPT_SHARED overrides)
+    std::string encoder, decoder, config;  ///< TorchScript modules and vae.json
+    bool torchscript() const { return !encoder.empty() || !decoder.empty() || !config.empty(); }
+};
+/// Loads the VAE; throws with the file name if it is missing or broken, or if only part of the
+/// TorchScript triple is given.
+std::unique_ptr<lpt::Vae> open_vae(const VaeSource& source);
+/// Whether open_vae can be expected to find its files (for "no VAE: latents only" fallbacks).
+bool vae_present(const VaeSource& source);
+/// The VAE a fit folder used (fit.json), with the defaults resolved.
+VaeSource manifest_vae(const std::string& fit_json_path);
 
 struct RenderArgs {
     std::string scene;
@@ -80,14 +97,15 @@ struct FitArgs {
     std::string encode_res = "256x256";  ///< image resolution for --encode (latent = image / 8)
     int ref_spp = 256;
     std::string ref_tone = "clip";       ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
-    std::string vae_dir;                 ///< default: <shared>/models/taesd3
+    VaeSource vae;
     bool refiner = true;                 ///< run stage 2 after stage 1
     RefineArgs refine;                   ///< stage-2 options (fitdir, seed, resume, quiet are filled in)
 };
 int run_fit(const FitArgs& args);
 
 struct VaeArgs {
-    std::string input, out, vae_dir;
+    std::string input, out;
+    VaeSource vae;
     bool quiet = false;
 };
 int run_encode(const VaeArgs& args);
@@ -101,15 +119,11 @@ int run_metrics(const MetricsArgs&);
 std::string default_vae_dir(const std::string& dir);
 /// ../shared (LATENTPT_SHARED overrides) + "/models/lpips" unless `dir` is given.
 std::string default_lpips_dir(const std::string& dir);
-/// Path-traced RGB of `scene_path` at width x height, tone-mapped as the paper does for its
-/// references (clip or reinhard, then gamma 1/2.2), encoded by the VAE in `vae_dir`.
-std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,
-                                     int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
-                                     const std::string& save_png);
-/// The same for a scene already in memory (an edited frame).
-/// `display_rgb`, if given, receives the tone-mapped RGB that was encoded.
+/// Path-traced RGB of `scene` at width x height, tone-mapped as the paper does for its
+/// references (clip or reinhard, then gamma 1/2.2), encoded by `vae`. `display_rgb`, if given,
+/// receives the tone-mapped RGB that was encoded.
 std::vector<float> encoded_reference_of(const lpt::Scene& scene, int width, int height, int spp, const std::string& tone,
-                                        const std::string& vae_dir, bool quiet, const std::string& save_png,
+                                        const lpt::Vae& vae, bool quiet, const std::string& save_png,
                                         std::vector<float>* display_rgb = nullptr);
 
 /// Parses "WxH"; throws std::invalid_argument with a clear message.

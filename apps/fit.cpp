@@ -7,6 +7,7 @@
 #include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
+#include "vae/vae.h"
 #include "refiner/refiner.h"
 #include <nlohmann/json.hpp>
 #include <filesystem>
@@ -80,7 +81,7 @@ int run_fit(const FitArgs& a) {
         int iw = 0, ih = 0;
         parse_resolution(a.encode_res, iw, ih);
         std::vector<float> ref_rgb;
-        target = encoded_reference_of(load_scene(a.scene, a.defines), iw, ih, a.ref_spp, a.ref_tone, a.vae_dir, a.quiet,
+        target = encoded_reference_of(load_scene(a.scene, a.defines), iw, ih, a.ref_spp, a.ref_tone, *open_vae(a.vae), a.quiet,
                                       (fs::path(a.out) / "reference.png").string(), &ref_rgb);
         // The refiner's LPIPS and metrics.json compare decoded latents with this image.
         write_exr((fs::path(a.out) / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}});
@@ -142,7 +143,10 @@ int run_fit(const FitArgs& a) {
     // Everything `latentpt render <fitdir> --edit` needs to rebuild this model.
     nlohmann::json manifest = {{"scene", fs::absolute(a.scene).string()}, {"defines", a.defines}, {"param", a.param}, {"gate", a.gate},
                                {"terms", a.terms}, {"tone", a.tone}, {"latent_width", w}, {"latent_height", h}, {"seed", a.seed},
-                               {"vae_dir", default_vae_dir(a.vae_dir)}, {"ref_tone", a.ref_tone}};
+                               {"vae_dir", default_vae_dir(a.vae.dir)}, {"ref_tone", a.ref_tone}};
+    if (a.vae.torchscript())
+        manifest["vae_torchscript"] = {{"encoder", fs::absolute(a.vae.encoder).string()}, {"decoder", fs::absolute(a.vae.decoder).string()},
+                                       {"config", fs::absolute(a.vae.config).string()}};
     write_text_atomic((out / "fit.json").string(), manifest.dump(2));
     write_latent((out / "latent.exr").string(), w, h, toned);
     // AOVs of the same view with the same samples: what the refiner reads beside the latent.
@@ -159,7 +163,7 @@ int run_fit(const FitArgs& a) {
     double final_loss = huber_loss(toned.data(), target.data(), toned.size(), 1.f, nullptr);
     if (a.encode) {
         // What a person looks at: the fitted latent decoded to RGB next to the reference.
-        VaeArgs d{(out / "latent.exr").string(), (out / "decoded.png").string(), a.vae_dir, true};
+        VaeArgs d{(out / "latent.exr").string(), (out / "decoded.png").string(), a.vae, true};
         run_decode(d);
         d.input = (out / "target.exr").string();
         d.out = (out / "target_decoded.png").string();

@@ -73,7 +73,14 @@ int main(int argc, char** argv) {
     fit->add_option("--encode-res", f.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")->capture_default_str();
     fit->add_option("--ref-spp", f.ref_spp, "samples per pixel of the RGB reference for --encode")->capture_default_str();
     fit->add_option("--ref-tone", f.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
-    fit->add_option("--vae-dir", f.vae_dir, "folder with <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
+    // The autoencoder: native TAESD3 weights, or any VAE exported to TorchScript (tools/export_vae.py).
+    auto vae_options = [](CLI::App* sc, VaeSource& vs) {
+        sc->add_option("--vae-dir", vs.dir, "TAESD3 weights folder, <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
+        sc->add_option("--vae-encoder", vs.encoder, "TorchScript encoder module (with --vae-decoder, --vae-config; e.g. the SD3.5 VAE)")->check(CLI::ExistingFile);
+        sc->add_option("--vae-decoder", vs.decoder, "TorchScript decoder module")->check(CLI::ExistingFile);
+        sc->add_option("--vae-config", vs.config, "vae.json of the TorchScript VAE: channels, downsample, scale, shift, image_range, latent")->check(CLI::ExistingFile);
+    };
+    vae_options(fit, f.vae);
     fit->add_option("-D,--define", fit_defines, "override a scene value (as for render)");
     fit->add_flag("!--no-refiner", f.refiner, "stop after stage 1 (no refiner training)");
     fit->add_flag("-q,--quiet", f.quiet, "no progress line");
@@ -104,7 +111,7 @@ int main(int argc, char** argv) {
     refine->add_flag("-q,--quiet", rf.quiet, "no progress line");
 
     VaeArgs v;
-    auto* encode = app.add_subcommand("encode", "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR (TAESD3)");
+    auto* encode = app.add_subcommand("encode", "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR (TAESD3 or a TorchScript VAE)");
     auto* decode = app.add_subcommand("decode", "latent EXR -> RGB image (PNG, or EXR unclamped)");
     auto* viz = app.add_subcommand("viz", "latent EXR -> PNG of its channels (green positive, red negative)");
     for (auto* sc : {encode, decode, viz}) {
@@ -112,7 +119,7 @@ int main(int argc, char** argv) {
         sc->add_option("-o,--out", v.out, "output file")->required();
         sc->add_flag("-q,--quiet", v.quiet, "no messages");
     }
-    for (auto* sc : {encode, decode}) sc->add_option("--vae-dir", v.vae_dir, "VAE weights folder (default: ../shared/models/taesd3)");
+    for (auto* sc : {encode, decode}) vae_options(sc, v.vae);
 
     MetricsArgs m;
     auto* metrics = app.add_subcommand("metrics", "MSE, PSNR, SSIM and LPIPS between two images (PNG display values or linear EXR), "

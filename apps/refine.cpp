@@ -97,20 +97,14 @@ int run_refine(const RefineArgs& a) {
     RefinerInput in = load_refiner_input((dir / "latent.exr").string(), (dir / "aov.exr").string());
     const int w = in.width, h = in.height;
     const Image target = read_checked(dir / "target.exr", kLatentChannels, w, h);
-    nlohmann::json manifest;
-    try {
-        manifest = nlohmann::json::parse(read_file((dir / "fit.json").string()));
-    } catch (const nlohmann::json::exception& e) {
-        throw std::runtime_error((dir / "fit.json").string() + ": malformed: " + e.what());
-    }
-    const std::string vae_dir = manifest.value("vae_dir", default_vae_dir(""));
+    const VaeSource vae_source = manifest_vae((dir / "fit.json").string());
     std::unique_ptr<Vae> vae;
     std::unique_ptr<Lpips> lpips;
-    if (fs::exists(fs::path(vae_dir) / "taesd3_decoder.safetensors")) vae = load_taesd(vae_dir);
+    if (vae_present(vae_source)) vae = open_vae(vae_source);
     const std::string lpips_dir = default_lpips_dir(a.lpips_dir);
     if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) lpips = Lpips::load(lpips_dir);
     if ((!vae || !lpips) && !a.quiet)
-        std::cerr << "note: no " << (vae ? "LPIPS weights in " + lpips_dir : "VAE in " + vae_dir) << ": refiner trains on latent MSE + SSIM only\n";
+        std::cerr << "note: no " << (vae ? "LPIPS weights in " + lpips_dir : "VAE (" + default_vae_dir(vae_source.dir) + ")") << ": refiner trains on latent MSE + SSIM only\n";
 
     // The image the decoded latents are judged against: the RGB reference when the fit encoded
     // one, else the decoded target.

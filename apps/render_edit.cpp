@@ -61,9 +61,10 @@ int run_render_edit(const RenderArgs& a) {
     std::vector<TriangleMesh> original;
     for (const Shape& s : scene.shapes) original.push_back(s.mesh);
     const Camera original_camera = scene.camera;
-    const std::string vae_dir = m.value("vae_dir", default_vae_dir(""));
-    const bool have_vae = fs::exists(fs::path(vae_dir) / "taesd3_decoder.safetensors");
-    if (!have_vae && !a.quiet) std::cerr << "note: no VAE at " << vae_dir << ": writing latents only\n";
+    const VaeSource vae_source = manifest_vae(manifest_path);
+    const bool have_vae = vae_present(vae_source);
+    if (a.reference && !have_vae) throw std::runtime_error("--reference needs the fit's VAE to encode references; not found: " + default_vae_dir(vae_source.dir));
+    if (!have_vae && !a.quiet) std::cerr << "note: the fit's VAE is not here (" << default_vae_dir(vae_source.dir) << "): writing latents only\n";
 
     const fs::path out(a.out.empty() || a.out == "render.exr" ? "edit-out" : a.out);
     fs::create_directories(out);
@@ -73,7 +74,7 @@ int run_render_edit(const RenderArgs& a) {
     else if (!a.quiet) std::cerr << "note: " << (dir / "refiner.pt").string() << " not found: frames are not refined\n";
     std::unique_ptr<Vae> vae;
     std::unique_ptr<Lpips> lpips;
-    if (have_vae) vae = load_taesd(vae_dir);
+    if (have_vae) vae = open_vae(vae_source);
     if (a.reference && have_vae) {
         const std::string lpips_dir = default_lpips_dir("");
         if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) lpips = Lpips::load(lpips_dir);
@@ -127,7 +128,7 @@ int run_render_edit(const RenderArgs& a) {
         if (a.reference) {
             // The edited scene file is not on disk: path trace this Scene directly.
             std::vector<float> ref_rgb;
-            std::vector<float> ref = encoded_reference_of(scene, 8 * w, 8 * h, a.ref_spp, m.value("ref_tone", "clip"), vae_dir, true,
+            std::vector<float> ref = encoded_reference_of(scene, 8 * w, 8 * h, a.ref_spp, m.value("ref_tone", "clip"), *vae, true,
                                                           stem + "_reference.png", &ref_rgb);
             csv << i << "," << t << frame_metrics(latent, ref, ref_rgb);
             if (refiner) csv << frame_metrics(refined, ref, ref_rgb);

@@ -6,6 +6,7 @@
 #include "core/scene_loader.h"
 #include "integrators/path.h"
 #include "vae/vae.h"
+#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -50,10 +51,41 @@ std::vector<float> rgb_of(const Image& img, const std::string& path) {
 
 }  // namespace
 
-std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const std::string& vae_dir,
+std::unique_ptr<Vae> open_vae(const VaeSource& s) {
+    if (!s.torchscript()) return load_taesd(default_vae_dir(s.dir));
+    if (s.encoder.empty() || s.decoder.empty() || s.config.empty())
+        throw std::invalid_argument("a TorchScript VAE needs all of --vae-encoder, --vae-decoder and --vae-config");
+    return load_torchscript_vae(s.encoder, s.decoder, s.config);
+}
+
+bool vae_present(const VaeSource& s) {
+    if (s.torchscript()) return fs::exists(s.encoder) && fs::exists(s.decoder) && fs::exists(s.config);
+    return fs::exists(fs::path(default_vae_dir(s.dir)) / "taesd3_decoder.safetensors");
+}
+
+VaeSource manifest_vae(const std::string& path) {
+    nlohmann::json m;
+    try {
+        m = nlohmann::json::parse(read_file(path));
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(path + ": malformed: " + e.what());
+    }
+    VaeSource s;
+    s.dir = m.value("vae_dir", default_vae_dir(""));
+    if (m.contains("vae_torchscript")) {
+        const auto& t = m["vae_torchscript"];
+        s.encoder = t.value("encoder", "");
+        s.decoder = t.value("decoder", "");
+        s.config = t.value("config", "");
+    }
+    return s;
+}
+
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const Vae& vae,
                                         bool quiet, const std::string& save_png, std::vector<float>* display_rgb) {
-    if (width % 8 || height % 8) throw std::invalid_argument("reference resolution must be a multiple of 8 in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
-    auto vae = load_taesd(default_vae_dir(vae_dir));
+    const int f = vae.convention().downsample;
+    if (width % f || height % f)
+        throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) + " in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions o = RenderOptions::from_scene(scene);
     o.width = width;
@@ -66,26 +98,19 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
     if (!quiet) std::cerr << "reference: " << width << "x" << height << " at " << spp << " spp in " << st.seconds << " s\n";
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
     if (display_rgb) *display_rgb = rgb;
-    return vae->encode(rgb, width, height);
-}
-
-std::vector<float> encoded_reference(const std::string& scene_path, const std::map<std::string, std::string>& defines, int width,
-                                     int height, int spp, const std::string& tone, const std::string& vae_dir, bool quiet,
-                                     const std::string& save_png) {
-    Scene scene = load_scene(scene_path, defines);
-    return encoded_reference_of(scene, width, height, spp, tone, vae_dir, quiet, save_png);
+    return vae.encode(rgb, width, height);
 }
 
 int run_encode(const VaeArgs& a) {
     Image img = read_image(a.input);
-    auto vae = load_taesd(default_vae_dir(a.vae_dir));
+    auto vae = open_vae(a.vae);
     // Files hold display values in [0, 1] (PNG/JPEG) or linear radiance (EXR): TAESD wants the former.
     std::vector<float> rgb = rgb_of(img, a.input);
     std::string ext = fs::path(a.input).extension().string();
     if (ext == ".exr" || ext == ".hdr")
         for (float& v : rgb) v = linear_to_srgb(v);
     std::vector<float> latent = vae->encode(rgb, img.width, img.height);
-    const int c = vae->convention().channels, w = img.width / 8, h = img.height / 8;
+    const int c = vae->convention().channels, w = img.width / vae->convention().downsample, h = img.height / vae->convention().downsample;
     write_exr(a.out, Image{w, h, c, latent, {}});
     if (!a.quiet) std::cerr << "wrote " << a.out << " (" << w << "x" << h << "x" << c << ")\n";
     return 0;
@@ -93,12 +118,13 @@ int run_encode(const VaeArgs& a) {
 
 int run_decode(const VaeArgs& a) {
     Image lat = read_image(a.input);
-    auto vae = load_taesd(default_vae_dir(a.vae_dir));
+    auto vae = open_vae(a.vae);
     if (lat.channels != vae->convention().channels)
         throw std::runtime_error(a.input + ": " + std::to_string(lat.channels) + " channels, the VAE's latents have " + std::to_string(vae->convention().channels));
     std::vector<float> rgb = vae->decode(lat.data, lat.width, lat.height);
     // Decoded values are display-referred (about [0, 1]): EXR keeps them unclamped, PNG as they are.
-    Image out{lat.width * 8, lat.height * 8, 3, rgb, {"R", "G", "B"}};
+    const int f = vae->convention().downsample;
+    Image out{lat.width * f, lat.height * f, 3, rgb, {"R", "G", "B"}};
     if (fs::path(a.out).extension() == ".exr") write_exr(a.out, out);
     else write_png_display(a.out, out);
     if (!a.quiet) std::cerr << "wrote " << a.out << " (" << out.width << "x" << out.height << ")\n";

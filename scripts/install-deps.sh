@@ -3,6 +3,8 @@
 # Package choices and pitfalls: ../shared/BUILD-NOTES.md
 #  - openimageio-tools: OpenImageIO's CMake config fails without its binaries.
 #  - libopenblas0-pthread: otherwise libtorch matrix products fall back to reference BLAS.
+#  - python3-torch: only for tools/export_*.py (TorchScript VAEs) and the test that exports
+#    TAESD3 and checks the TorchScript path against the native one.
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build ccache pkg-config
@@ -11,6 +13,7 @@ pkgs=(
   libopenimageio-dev openimageio-tools
   libtinygltf-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libcli11-dev
   libgtest-dev libbenchmark-dev
+  python3-torch
 )
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi

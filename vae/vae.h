@@ -33,4 +33,9 @@ public:
 std::unique_ptr<Vae> load_taesd(const std::string& dir, const std::string& prefix = "taesd3",
                                 const LatentConvention& convention = LatentConvention{});
 
+/// A VAE exported as TorchScript: `encoder` and `decoder` modules and `config` (vae.json: channels,
+/// downsample, scale, shift, image_range, latent "raw" | "model"; docs/vae.md). Throws
+/// std::runtime_error naming the file and field on a missing file, a bad module or config.
+std::unique_ptr<Vae> load_torchscript_vae(const std::string& encoder, const std::string& decoder, const std::string& config);
+
 }  // namespace lpt

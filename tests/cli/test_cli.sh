@@ -48,6 +48,15 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" encode "$out/e.png" -q --out "$out/lat.exr"; check test -s "$out/lat.exr"
     check test "$("$bin" decode "$out/lat.exr" -q --out "$out/dec.png" && oiiotool --info "$out/dec.png" | grep -c '32 x   16')" -eq 1
     "$bin" viz "$out/lat.exr" -q --out "$out/viz.png"; check test -s "$out/viz.png"
+    # The TorchScript VAE path from the command line: TAESD3 exported by our script encodes alike.
+    py=/usr/bin/python3; [ -x "$py" ] || py=python3
+    if "$py" -c 'import torch' 2>/dev/null && "$py" "$src/tools/export_taesd3.py" --weights "$shared/models/taesd3" --out "$out/ts" >/dev/null; then
+        "$bin" encode "$out/e.png" -q --vae-encoder "$out/ts/encoder.pt" --vae-decoder "$out/ts/decoder.pt" --vae-config "$out/ts/vae.json" --out "$out/lat_ts.exr"
+        check oiiotool "$out/lat_ts.exr" "$out/lat.exr" --fail 1e-4 --diff
+        expect_error "all of --vae-encoder" "$bin" encode "$out/e.png" -q --vae-encoder "$out/ts/encoder.pt" --out "$out/x.exr"
+    else
+        echo "skipping TorchScript VAE checks: no python3 with torch (python3-torch)"
+    fi
     expect_error "channels" "$bin" decode "$out/r.exr" -q --out "$out/x.png"
     "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q $small_refiner --out "$out/enc"
     for f in reference.png reference_rgb.exr target.exr target_decoded.png decoded.png decoded_refined.png metrics.json; do check test -s "$out/enc/$f"; done

@@ -1,0 +1,143 @@
+// Any VAE exported as two TorchScript modules (tools/export_vae.py for the SD3.5 VAE,
+// tools/export_taesd3.py for TAESD3) plus vae.json describing its conventions:
+//   {"channels": 16, "downsample": 8, "scale": 1.5305, "shift": 0.0609,
+//    "image_range": [-1, 1], "latent": "raw" | "model"}
+// Images cross this interface in [0, 1] and latents in the diffusion model's space; the affine
+// maps to and from the modules' own ranges happen here, so the modules stay plain exports.
+#include "vae/vae_torch.h"
+#include <nlohmann/json.hpp>
+#include <torch/script.h>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+
+namespace lpt {
+
+namespace {
+
+torch::jit::Module load_module(const std::string& path, const char* role) {
+    if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": " + role + " module not found");
+    try {
+        torch::jit::Module m = torch::jit::load(path);
+        m.eval();
+        return m;
+    } catch (const c10::Error& e) {
+        throw std::runtime_error(path + ": cannot load TorchScript " + role + ": " + e.what_without_backtrace());
+    }
+}
+
+std::string shape_of(const torch::Tensor& t) {
+    std::string s = "[";
+    for (int64_t i = 0; i < t.dim(); ++i) s += (i ? ", " : "") + std::to_string(t.size(i));
+    return s + "]";
+}
+
+class TorchScriptVae final : public Vae, public TorchVae {
+public:
+    TorchScriptVae(const std::string& encoder, const std::string& decoder, const std::string& config) {
+        std::ifstream f(config);
+        if (!f) throw std::runtime_error(config + ": VAE config not found");
+        nlohmann::json j;
+        try {
+            j = nlohmann::json::parse(f);
+        } catch (const nlohmann::json::exception& e) {
+            throw std::runtime_error(config + ": malformed JSON: " + e.what());
+        }
+        auto field = [&](const char* k) -> const nlohmann::json& {
+            if (!j.contains(k)) throw std::runtime_error(config + ": missing field '" + k + "'");
+            return j[k];
+        };
+        try {
+            m_conv.channels = field("channels").get<int>();
+            m_conv.downsample = field("downsample").get<int>();
+            m_conv.scale = field("scale").get<float>();
+            m_conv.shift = field("shift").get<float>();
+            const auto range = field("image_range").get<std::vector<float>>();
+            if (range.size() != 2 || !(range[1] > range[0])) throw std::runtime_error(config + ": field 'image_range' must be [low, high] with low < high");
+            m_lo = range[0];
+            m_hi = range[1];
+            const std::string latent = field("latent").get<std::string>();
+            if (latent != "raw" && latent != "model") throw std::runtime_error(config + ": field 'latent' must be \"raw\" or \"model\", got \"" + latent + "\"");
+            m_raw = latent == "raw";
+        } catch (const nlohmann::json::exception& e) {
+            throw std::runtime_error(config + ": wrong type of a field: " + e.what());
+        }
+        if (m_conv.channels < 1 || m_conv.downsample < 1 || m_conv.scale == 0.f)
+            throw std::runtime_error(config + ": channels and downsample must be >= 1 and scale non-zero");
+        m_encoder_path = encoder;
+        m_decoder_path = decoder;
+        m_enc = load_module(encoder, "encoder");
+        m_dec = load_module(decoder, "decoder");
+        at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency())));
+    }
+
+    std::vector<float> encode(const std::vector<float>& rgb, int width, int height) const override {
+        const int f = m_conv.downsample;
+        if (width % f || height % f)
+            throw std::invalid_argument("encode: image " + std::to_string(width) + "x" + std::to_string(height) + " is not a multiple of " +
+                                        std::to_string(f) + " in both axes (crop or pad it first)");
+        if (rgb.size() != size_t(width) * height * 3) throw std::invalid_argument("encode: expected width*height*3 floats");
+        torch::NoGradGuard no_grad;
+        return to_hwc(encode_nchw(torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2}).contiguous()));
+    }
+
+    std::vector<float> decode(const std::vector<float>& latent, int width, int height) const override {
+        const int c = m_conv.channels;
+        if (latent.size() != size_t(width) * height * c)
+            throw std::invalid_argument("decode: expected " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(c) +
+                                        " floats, got " + std::to_string(latent.size()));
+        torch::NoGradGuard no_grad;
+        return to_hwc(decode_nchw(torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c}).permute({0, 3, 1, 2}).contiguous()));
+    }
+
+    torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {
+        torch::Tensor z = run(m_enc, m_encoder_path, rgb * (m_hi - m_lo) + m_lo);
+        const int f = m_conv.downsample;
+        if (z.dim() != 4 || z.size(1) != m_conv.channels || z.size(2) * f != rgb.size(2) || z.size(3) * f != rgb.size(3))
+            throw std::runtime_error(m_encoder_path + ": encoder returned " + shape_of(z) + " for an image " + shape_of(rgb) +
+                                     "; the config says " + std::to_string(m_conv.channels) + " channels at 1/" + std::to_string(f));
+        return m_raw ? (z - m_conv.shift) * m_conv.scale : z;
+    }
+
+    torch::Tensor decode_nchw(const torch::Tensor& latent) const override {
+        torch::Tensor x = run(m_dec, m_decoder_path, m_raw ? latent / m_conv.scale + m_conv.shift : latent);
+        const int f = m_conv.downsample;
+        if (x.dim() != 4 || x.size(1) != 3 || x.size(2) != latent.size(2) * f || x.size(3) != latent.size(3) * f)
+            throw std::runtime_error(m_decoder_path + ": decoder returned " + shape_of(x) + " for a latent " + shape_of(latent));
+        return (x - m_lo) / (m_hi - m_lo);
+    }
+
+    const LatentConvention& convention() const override { return m_conv; }
+
+private:
+    static torch::Tensor run(torch::jit::Module& m, const std::string& path, const torch::Tensor& x) {
+        try {
+            c10::IValue out = m.forward({x});
+            if (!out.isTensor()) throw std::runtime_error(path + ": forward() must return one tensor");
+            return out.toTensor().to(torch::kFloat32);
+        } catch (const c10::Error& e) {
+            throw std::runtime_error(path + ": forward failed: " + e.what_without_backtrace());
+        }
+    }
+    static std::vector<float> to_hwc(const torch::Tensor& nchw) {
+        torch::Tensor t = nchw.permute({0, 2, 3, 1}).contiguous();
+        return std::vector<float>(t.data_ptr<float>(), t.data_ptr<float>() + t.numel());
+    }
+
+    LatentConvention m_conv;
+    float m_lo = 0.f, m_hi = 1.f;
+    bool m_raw = false;
+    std::string m_encoder_path, m_decoder_path;
+    // forward() is not const in libtorch; running a module does not change what it computes.
+    mutable torch::jit::Module m_enc, m_dec;
+};
+
+}  // namespace
+
+std::unique_ptr<Vae> load_torchscript_vae(const std::string& encoder, const std::string& decoder, const std::string& config) {
+    return std::make_unique<TorchScriptVae>(encoder, decoder, config);
+}
+
+}  // namespace lpt
