@@ -12,7 +12,9 @@ namespace lpt {
 namespace {
 
 using L = Latent;
-constexpr int kMaxKeys = 2;
+/// Most colour coefficients of one BSDF: a textured roughplastic has diffuse .scale, .offset and
+/// specular_reflectance. Checked when the adjoint is built: never silently truncated.
+constexpr int kMaxKeys = 3;
 
 struct Event {
     enum Type : uint8_t { Emission, Ambient, Light, Bounce } type = Emission;
@@ -21,7 +23,7 @@ struct Event {
     float scalar = 0.f;  ///< Emission: MIS weight; Light: w / pdf; Bounce: RR probability q
     L beta = L::Zero();  ///< throughput in front of this vertex
     L local = L::Zero(); ///< Bounce: weight / q; Light: ∂value/∂L̃e coefficient f · w / pdf
-    L grad[kMaxKeys] = {L::Zero(), L::Zero()};  ///< Light: ∂f/∂c_k · w/pdf; Bounce: ∂weight/∂c_k / q
+    L grad[kMaxKeys] = {L::Zero(), L::Zero(), L::Zero()};  ///< Light: ∂f/∂c_k · w/pdf; Bounce: ∂weight/∂c_k / q
     L sgrad = L::Zero();  ///< the same for the BSDF's scalar parameter (roughness), if any
 };
 
@@ -34,6 +36,9 @@ public:
     Adjoint(LatentModel& model, const RenderOptions& opt, const std::vector<float>& d_image, int width, int n_tiles)
         : m_model(model), m_d_image(d_image), m_inv_spp(1.f / float(opt.spp)), m_tile_grads(n_tiles) {
         (void)width;
+        for (size_t i = 0; i < model.scene().shapes.size(); ++i)
+            if (model.slots(int(i)).bsdf.size() > size_t(kMaxKeys))
+                throw std::logic_error("path replay: shape '" + model.scene().shapes[i].id + "' has more BSDF coefficients than kMaxKeys");
     }
 
     void begin(int tile, size_t n) override {

@@ -2,14 +2,11 @@
 // as Mitsuba 3's diffuse). Sampling is cosine-weighted and independent of the reflectance.
 // Keys: reflectance (rgb, default 0.5; signed values allowed for latent channels, never clamped;
 // or a bitmap texture, core/texture.h). Equations: docs/bsdfs.md (13).
-// A textured reflectance is looked up at ctx.uv for N = 3 only. Other N (latent channels) use
-// the constant spectrum_from_rgb of the image's mean colour, which set_spectral overrides as
-// for an untextured material: latent textures (grey image x scale + offset per channel) are
-// issue 7, and eval_grad stays that of one coefficient per material.
+// A textured reflectance is the texel's RGB for N = 3 and g(uv)·s + o for latent channels
+// (core/surface_colour.h), fitted as reflectance.scale and reflectance.offset.
 #include "core/bsdf.h"
-#include "core/texture.h"
+#include "core/surface_colour.h"
 #include "core/warp.h"
-#include <optional>
 
 namespace lpt {
 namespace {
@@ -17,16 +14,11 @@ namespace {
 template <int N>
 class Diffuse final : public BSDF<N> {
 public:
-    explicit Diffuse(const Props& props) {
-        Texture tex = texture_from_props(props, "reflectance", Eigen::Array3f::Constant(0.5f));
-        m_reflectance = spectrum_from_rgb<N>(tex.mean());  // the constant itself if untextured
-        if constexpr (N == 3)
-            if (!tex.is_constant()) m_texture = std::move(tex);
-    }
+    explicit Diffuse(const Props& props) : m_reflectance(props, "reflectance", Eigen::Array3f::Constant(0.5f)) {}
 
     Spectrum<N> eval(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const override {
         if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
-        return reflectance(ctx) * (kInvPi * cos_theta(wo));  // docs/bsdfs.md (13)
+        return m_reflectance.eval(ctx) * (kInvPi * cos_theta(wo));  // docs/bsdfs.md (13)
     }
 
     float pdf(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -41,34 +33,27 @@ public:
         bs.pdf = pdf_cosine_hemisphere(bs.wo);
         if (!(bs.pdf > 0.f)) return BSDFSample<N>();  // wo on the horizon: eval would be 0
         bs.lobe = kDiffuseReflection;
-        bs.weight = reflectance(ctx);  // (R/pi cos) / (cos/pi), exactly
+        bs.weight = m_reflectance.eval(ctx);  // (R/pi cos) / (cos/pi), exactly
         return bs;
     }
 
     uint32_t flags() const override { return kDiffuseReflection; }
-    Spectrum<N> albedo(const BSDFContext& ctx) const override { return reflectance(ctx); }
+    Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_reflectance.eval(ctx); }
 
-    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int) const override {
+    /// ∂ρ/∂c · cos/π: 1 for the constant, g(uv) for .scale, 1 for .offset.
+    Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
         if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
-        return Spectrum<N>::Constant(kInvPi * cos_theta(wo));
+        return Spectrum<N>::Constant(m_reflectance.factor(ctx, key) * kInvPi * cos_theta(wo));
     }
 
-    std::vector<std::string> spectral_keys() const override { return {"reflectance"}; }
+    std::vector<std::string> spectral_keys() const override { return m_reflectance.keys(); }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
-        if (key != "reflectance") BSDF<N>::set_spectral(key, v);
-        m_reflectance = v;
-        m_texture.reset();  // a fitted coefficient replaces the image, for N = 3 too
+        // A fitted constant replaces an RGB image (N = 3); latent textures keep theirs.
+        if (!m_reflectance.set(key, v)) BSDF<N>::set_spectral(key, v);
     }
 
 private:
-    Spectrum<N> reflectance(const BSDFContext& ctx) const {
-        if constexpr (N == 3)
-            if (m_texture) return m_texture->eval(ctx.uv);
-        return m_reflectance;
-    }
-
-    Spectrum<N> m_reflectance;
-    std::optional<Texture> m_texture;  ///< only ever set for N = 3
+    SurfaceColour<N> m_reflectance;
 };
 
 }  // namespace

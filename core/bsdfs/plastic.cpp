@@ -10,7 +10,8 @@
 // (Mitsuba also weighs by mean reflectances, which are signed in latent space); the diffuse
 // Fresnel reflectance is integrated numerically instead of Mitsuba's polynomial fits (they
 // differ by < 0.2% for 1.2 <= IOR <= 2), which makes a white plastic conserve energy exactly.
-// Gradients w.r.t. diffuse_reflectance (key 0) and specular_reflectance (key 1): docs/bsdfs.md
+// Gradients w.r.t. the diffuse colour (keys below the substrate's key_count: diffuse_reflectance, or its
+// .scale/.offset when latent-textured, ∂ρ̃/∂c = ∂ρ̃/∂ρ · ∂ρ/∂c) and specular_reflectance (the last key): docs/bsdfs.md
 // (34)-(35); with nonlinear = true the base colour is not affine in diffuse_reflectance.
 // Equations: docs/bsdfs.md (1), (4), (22)-(24), (34)-(35).
 #include "core/bsdf.h"
@@ -33,11 +34,16 @@ public:
         m_substrate.set_internal_reflectance(fresnel_diffuse_reflectance(1.f / m_eta));
     }
 
-    std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
+    /// The substrate colour's keys (diffuse_reflectance, or .scale/.offset when latent-textured),
+    /// then specular_reflectance: key indices below m_substrate.key_count() are the colour's.
+    std::vector<std::string> spectral_keys() const override {
+        std::vector<std::string> k = m_substrate.keys();
+        k.push_back("specular_reflectance");
+        return k;
+    }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
-        if (key == "diffuse_reflectance") m_substrate.set_colour(v);
-        else if (key == "specular_reflectance") m_specular = v;
-        else BSDF<N>::set_spectral(key, v);
+        if (key == "specular_reflectance") m_specular = v;
+        else if (!m_substrate.set(key, v)) BSDF<N>::set_spectral(key, v);
     }
 
     Spectrum<N> eval(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const override {
@@ -83,20 +89,21 @@ public:
     /// 1/(1 − ρ Fdr)² for nonlinear = true, so there it depends on the current diffuse
     /// reflectance (the gradient at the present coefficients, not a global constant). Key 1
     /// (specular_reflectance): 0, the specular lobe is delta and not part of eval.
-    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int key) const override {
-        if (key != 0 || cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
+    Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
+        if (key >= m_substrate.key_count() || cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
         float t_i = 1.f - fresnel_dielectric(cos_theta(wi), m_eta).R;
         float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
-        return m_substrate.d_base_d_colour() * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));
+        return m_substrate.d_base(ctx, key) * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));
     }
     /// ∂(bs.weight)/∂c, docs/bsdfs.md (35): the delta sample's weight is specular_reflectance
     /// (22), so 1 for key 1 and 0 for key 0; the diffuse sample's closed-form weight ρ̃ (1 − R_o)/η²
     /// (24) gives ∂ρ̃/∂ρ (1 − R_o)/η² for key 0 (current-ρ dependent when nonlinear) and 0 for key 1.
-    Spectrum<N> weight_grad(const BSDFContext&, const Vec3f&, const BSDFSample<N>& bs, int key) const override {
-        if (bs.lobe == kDeltaReflection) return Spectrum<N>::Constant(key == 1 ? 1.f : 0.f);
-        if (key != 0) return Spectrum<N>::Zero();
+    Spectrum<N> weight_grad(const BSDFContext& ctx, const Vec3f&, const BSDFSample<N>& bs, int key) const override {
+        const bool specular_key = key == m_substrate.key_count();
+        if (bs.lobe == kDeltaReflection) return Spectrum<N>::Constant(specular_key ? 1.f : 0.f);
+        if (specular_key) return Spectrum<N>::Zero();
         float t_o = 1.f - fresnel_dielectric(cos_theta(bs.wo), m_eta).R;
-        return m_substrate.d_base_d_colour() * (m_inv_eta2 * t_o);
+        return m_substrate.d_base(ctx, key) * (m_inv_eta2 * t_o);
     }
 
 private:

@@ -12,7 +12,8 @@
 // applied to the rough table (Mitsuba integrates the internal rough reflectance separately),
 // which makes a white roughplastic conserve energy up to the table's accuracy (~1e-3): the
 // base receives exactly what the rough coating does not reflect.
-// Gradients w.r.t. diffuse_reflectance (key 0) and specular_reflectance (key 1): docs/bsdfs.md
+// Gradients w.r.t. the diffuse colour (keys below the substrate's key_count, as plastic.cpp) and
+// specular_reflectance (the last key): docs/bsdfs.md
 // (34), (36); with nonlinear = true the base colour is not affine in diffuse_reflectance.
 // Scalar key "alpha" (roughness): set_scalar rebuilds the t(mu) table, Fdr_int and the base
 // colour; ∂/∂α covers the specular lobe AND the diffuse lobe's α-dependence through t(cos θi),
@@ -44,11 +45,16 @@ public:
         rebuild();
     }
 
-    std::vector<std::string> spectral_keys() const override { return {"diffuse_reflectance", "specular_reflectance"}; }
+    /// The substrate colour's keys (diffuse_reflectance, or .scale/.offset when latent-textured),
+    /// then specular_reflectance: key indices below m_substrate.key_count() are the colour's.
+    std::vector<std::string> spectral_keys() const override {
+        std::vector<std::string> k = m_substrate.keys();
+        k.push_back("specular_reflectance");
+        return k;
+    }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
-        if (key == "diffuse_reflectance") m_substrate.set_colour(v);
-        else if (key == "specular_reflectance") m_specular = v;
-        else BSDF<N>::set_spectral(key, v);
+        if (key == "specular_reflectance") m_specular = v;
+        else if (!m_substrate.set(key, v)) BSDF<N>::set_spectral(key, v);
     }
 
     std::vector<std::string> scalar_keys() const override { return {"alpha"}; }
@@ -120,11 +126,11 @@ public:
     /// reflectance. Key 1 (specular_reflectance): the specular term of (25) without the colour.
     /// weight_grad keeps the base-class default: sample() returns exactly eval/pdf (28) with a
     /// coefficient-independent pdf, so ∂weight/∂c = eval_grad/pdf.
-    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int key) const override {
+    Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
         float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
-        if (key == 0)
-            return m_substrate.d_base_d_colour() * (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
+        if (key < m_substrate.key_count())
+            return m_substrate.d_base(ctx, key) * (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
         Vec3f h = (wi + wo).normalized();
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);
         if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
@@ -140,7 +146,7 @@ public:
     /// the two agree to the tables' accuracy (measured in tests/core/bsdfs/test_bsdf_alpha.cpp).
     /// weight_grad_scalar keeps the base-class default: sample() returns exactly eval/pdf (28)
     /// and path replay holds bs.wo and bs.pdf fixed (docs/bsdfs.md (43)).
-    Spectrum<N> eval_grad_scalar(const BSDFContext&, const Vec3f& wi, const Vec3f& wo, int key) const override {
+    Spectrum<N> eval_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
         if (key != 0) throw std::invalid_argument("roughplastic: scalar key index out of range");
         float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
@@ -150,7 +156,7 @@ public:
         float t_i = transmittance(cos_i), t_o = transmittance(cos_o);
         float dt_i = interpolate(m_dtable, cos_i), dt_o = interpolate(m_dtable, cos_o);
         float k = m_inv_eta2 * kInvPi * cos_o;
-        return m_specular * dspec + m_substrate.d_base_d_alpha() * (k * t_i * t_o) + m_substrate.base_constant() * (k * (dt_i * t_o + t_i * dt_o));
+        return m_specular * dspec + m_substrate.d_base_d_alpha(ctx) * (k * t_i * t_o) + m_substrate.base(ctx) * (k * (dt_i * t_o + t_i * dt_o));
     }
 
 private:

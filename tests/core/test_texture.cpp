@@ -258,12 +258,23 @@ TEST(Texture, DiffuseWithBitmapReflectance) {
     ctx.uv = Vec2f(0.25f, 0.25f);
     expect_rgb(bsdf->albedo(ctx), Eigen::Array3f::Constant(0.2f));
 
-    // Latent channels: the mean colour as one constant, whatever the uv (issue 7 adds more).
+    // Latent channels: ρ(uv) = g(uv)·s + o with g the texel's luminance; before fitting
+    // s = the mean colour's luminance / g of the mean = 1 per channel, o = 0, so ρ = g(uv).
     auto latent = make_bsdf<16>(p);
-    Spectrum<16> a = latent->albedo(ctx);
-    ctx.uv = Vec2f(0.75f, 0.75f);
-    EXPECT_TRUE(latent->albedo(ctx).isApprox(a));
-    EXPECT_NEAR(a[0], luminance(Color3(0.5f, 0.5f, 0.25f)), 1e-6f);
+    EXPECT_EQ(latent->spectral_keys(), (std::vector<std::string>{"reflectance.scale", "reflectance.offset"}));
+    for (Vec2f uv : {Vec2f(0.25f, 0.25f), Vec2f(0.4f, 0.6f)}) {
+        ctx.uv = uv;
+        const float g = luminance(Color3(uv.x() == 0.25f ? Color3(kRed) : Color3(0.42f, 0.30f, 0.49f)));
+        EXPECT_TRUE(latent->albedo(ctx).isApprox(Spectrum<16>::Constant(g), 1e-5f)) << latent->albedo(ctx).transpose();
+        latent->set_spectral("reflectance.scale", Spectrum<16>::LinSpaced(-1.f, 2.f));
+        latent->set_spectral("reflectance.offset", Spectrum<16>::Constant(0.1f));
+        EXPECT_TRUE(latent->albedo(ctx).isApprox(Spectrum<16>::LinSpaced(-1.f, 2.f) * g + 0.1f, 1e-5f));
+        // ∂(f cos)/∂s = g cos/π, ∂/∂o = cos/π (eval_grad keys 0 and 1).
+        EXPECT_NEAR(latent->eval_grad(ctx, wi, wo, 0)[3], g * wo.z() * kInvPi, 1e-6f);
+        EXPECT_NEAR(latent->eval_grad(ctx, wi, wo, 1)[3], wo.z() * kInvPi, 1e-6f);
+        latent = make_bsdf<16>(p);
+    }
+    EXPECT_THROW(latent->set_spectral("reflectance", Spectrum<16>::Zero()), std::invalid_argument);
 }
 
 TEST(Texture, ObjUvsWithFlipPutTheImageTopAtVtOne) {
