@@ -1,20 +1,28 @@
-// Emitters: one-sided area lights attached to shapes, and a constant environment. Their
+// Emitters: one-sided area lights attached to shapes, a constant environment, and an
+// environment map (core/envmap.h). Their
 // radiance is spectral data (SceneSpectra<N>); this header holds the geometric part that
 // sampling needs, which never depends on learned (signed) radiance. Equations: docs/sampling.md.
 #pragma once
 #include "core/geometry.h"
 #include "core/props.h"
 #include "core/shape.h"
+#include <memory>
 
 namespace lpt {
 
-enum class EmitterKind { Area, Constant };
+enum class EmitterKind { Area, Constant, EnvMap };
+
+class EnvMap;
 
 struct Emitter {
     EmitterKind kind = EmitterKind::Area;
     int shape = -1;                 ///< emitting shape (Area only)
-    Eigen::Array3f radiance_rgb = Eigen::Array3f::Ones();  ///< as described in the scene file
+    /// As described in the scene file; for an EnvMap its mean radiance over the sphere (light
+    /// selection by power, and the latent environment's starting value).
+    Eigen::Array3f radiance_rgb = Eigen::Array3f::Ones();
     Props props;                    ///< the description, for error messages and other N
+    std::shared_ptr<const EnvMap> envmap;  ///< EnvMap only
+    bool is_environment() const { return kind != EmitterKind::Area; }
 };
 
 struct LightSample {

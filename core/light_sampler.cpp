@@ -1,4 +1,5 @@
 #include "core/light_sampler.h"
+#include "core/envmap.h"
 #include "core/spectrum.h"
 #include <algorithm>
 
@@ -50,9 +51,9 @@ LightSample LightSampler::sample(const std::vector<Emitter>& emitters, const std
     float u_tri;
     int i = choose(u_choice, &u_tri);
     const Emitter& e = emitters[i];
-    LightSample ls = e.kind == EmitterKind::Area
-                         ? sample_area_light(shapes[e.shape], ref, Eigen::Vector3f(u_tri, u_pos.x(), u_pos.y()))
-                         : sample_constant_light(u_pos);
+    LightSample ls = e.kind == EmitterKind::Area     ? sample_area_light(shapes[e.shape], ref, Eigen::Vector3f(u_tri, u_pos.x(), u_pos.y()))
+                     : e.kind == EmitterKind::EnvMap ? e.envmap->sample(u_pos)
+                                                     : sample_constant_light(u_pos);
     ls.emitter = i;
     ls.pdf *= m_pmf[i];
     return ls;

@@ -4,6 +4,7 @@
 // → trace shadow rays → swap ray queues. Short per-stage loops also let the CPU overlap paths.
 // Equations: docs/transport.md (1)–(4). Random dimensions: core/sampler.h.
 #include "integrators/path.h"
+#include "core/envmap.h"
 #include "core/sampler.h"
 #include "integrators/wavefront_state.h"
 #include <tbb/enumerable_thread_specific.h>
@@ -105,6 +106,23 @@ private:
         st.camera_rays += n;
     }
 
+    /// Radiance of emitter e arriving along -w (w points from the scene toward the emitter):
+    /// SceneSpectra's spectrum, and for an environment map its direction dependence: the RGB
+    /// texel itself for N = 3, the texel's relative luminance times the (learned) spectrum for
+    /// latent N. `factor` is that scalar (1 otherwise), folded into the observer's weights so path
+    /// replay sees radiance[e] · factor.
+    Spectrum<N> emitted(int e, const Vec3f& w, float* factor) const {
+        const Emitter& em = m_scene.emitters[e];
+        *factor = 1.f;
+        if (em.kind != EmitterKind::EnvMap) return m_spectra.radiance[e];
+        if constexpr (N == 3) {
+            return em.envmap->eval(w);
+        } else {
+            *factor = em.envmap->relative_luminance(w);
+            return m_spectra.radiance[e] * *factor;
+        }
+    }
+
     /// docs/transport.md (3): weight of an emitter reached by BSDF sampling.
     float hit_weight(const PathState<N>& p, uint32_t slot, float light_pdf) const {
         if (p.prev_delta[slot] || m_opt.strategy == LightStrategy::Bsdf) return 1.f;
@@ -129,10 +147,15 @@ private:
                     if (m_obs) m_obs->ambient(slot, -1, p.beta[slot]);
                 }
                 if (env < 0 || !m_emission) continue;
-                float w = hit_weight(p, slot, m_scene.lights.pmf(env) * pdf_constant_light());
+                const Vec3f dir = rays.direction(i);
+                const Emitter& em = m_scene.emitters[env];
+                const float env_pdf = em.kind == EmitterKind::EnvMap ? em.envmap->pdf(dir) : pdf_constant_light();
+                float w = hit_weight(p, slot, m_scene.lights.pmf(env) * env_pdf);
                 if (w > 0.f) {
-                    p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[env]);
-                    if (m_obs) m_obs->emission(slot, env, p.beta[slot], w);
+                    float factor;
+                    const Spectrum<N> le = emitted(env, dir, &factor);
+                    p.radiance[slot] += p.beta[slot] * (w * le);
+                    if (m_obs) m_obs->emission(slot, env, p.beta[slot], w * factor);
                 }
                 continue;
             }
@@ -219,8 +242,10 @@ private:
                 // A zero f (a latent reflectance at 0) still has a derivative: keep it for the adjoint.
                 if ((f != 0.f).any() || m_obs) {
                     float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
-                    w_over_pdf = w / ls.pdf;
-                    contribution = p.beta[slot] * f * m_spectra.radiance[ls.emitter] * w_over_pdf;
+                    float factor;
+                    const Spectrum<N> le = emitted(ls.emitter, ls.wi, &factor);
+                    contribution = p.beta[slot] * f * le * (w / ls.pdf);
+                    w_over_pdf = w / ls.pdf * factor;  // the observer multiplies by radiance[emitter]
                 } else if (!first) {
                     continue;
                 }
@@ -231,7 +256,7 @@ private:
             Vec3f o = offset_ray_origin(sq.p[k], sq.ng[k], ls.wi);
             Vec3f dir = ls.wi;
             float tmax = kInf;
-            if (m_scene.emitters[ls.emitter].kind != EmitterKind::Constant) {
+            if (!m_scene.emitters[ls.emitter].is_environment()) {
                 Vec3f d = ls.p - o;
                 float dist = d.norm();
                 dir = d / dist;

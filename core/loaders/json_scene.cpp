@@ -3,6 +3,7 @@
 #include "core/bsdf.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "core/envmap.h"
 #include "core/texture.h"
 #include <nlohmann/json.hpp>
 #include <filesystem>
@@ -303,13 +304,34 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
         if (!ej->is_array()) c.fail("emitters", "expected an array");
         for (size_t i = 0; i < ej->size(); ++i) {
             std::string f = "emitters[" + std::to_string(i) + "]";
-            Props ep = c.props((*ej)[i], f);
-            if (ep.type != "constant") c.fail(f + ".type", "top-level emitters must be 'constant' (area lights belong inside a shape), got '" + ep.type + "'");
+            const json& ejson = (*ej)[i];
+            json plain = ejson;  // to_world is a transform, not a plugin value
+            if (plain.is_object()) plain.erase("to_world");
+            Props ep = c.props(plain, f);
+            if (ep.type != "constant" && ep.type != "envmap")
+                c.fail(f + ".type", "top-level emitters must be 'constant' or 'envmap' (area lights belong inside a shape), got '" + ep.type + "'");
             if (scene.environment >= 0) c.fail(f, "only one environment emitter is supported");
             Emitter e;
-            e.kind = EmitterKind::Constant;
-            e.radiance_rgb = ep.get_rgb("radiance");
             e.props = ep;
+            if (ep.type == "constant") {
+                e.kind = EmitterKind::Constant;
+                e.radiance_rgb = ep.get_rgb("radiance");
+            } else {
+                // {"type": "envmap", "filename": "sky.exr", "scale": 1, "to_world": ...}
+                for (const auto& [k, v] : ejson.items())
+                    if (k != "type" && k != "filename" && k != "scale" && k != "to_world") c.fail(f + "." + k, "unknown envmap key (filename, scale, to_world)");
+                const std::string name = ep.get_string("filename", "");
+                if (name.empty()) c.fail(f + ".filename", "missing");
+                Transform to_world;
+                if (auto* t = c.opt(ejson, "to_world")) to_world = c.transform(*t, f + ".to_world");
+                try {
+                    e.envmap = EnvMap::load(fs::absolute(c.dir / name).lexically_normal().string(), to_world, ep.get_float("scale", 1.f));
+                } catch (const SceneError& err) {
+                    c.fail(f + ".filename", err.what());
+                }
+                e.kind = EmitterKind::EnvMap;
+                e.radiance_rgb = e.envmap->mean_radiance();
+            }
             scene.environment = int(scene.emitters.size());
             scene.emitters.push_back(e);
         }

@@ -5,6 +5,7 @@
 #include "core/bsdf.h"
 #include "core/loaders/mitsuba_xml_detail.h"
 #include "core/scene_loader.h"
+#include "core/envmap.h"
 #include "core/texture.h"
 #include <filesystem>
 #include <fstream>
@@ -375,15 +376,34 @@ private:
 
     void read_top_emitter(const pugi::xml_node& n) {
         Plugin p = read_plugin(n, "emitter");
-        if (p.type == "envmap") src.fail_at(p.line, p.where + ".type", "envmap is not supported yet (use a 'constant' emitter)");
         if (p.type == "area") src.fail_at(p.line, p.where + ".type", "an 'area' emitter must be nested inside a <shape>");
-        if (p.type != "constant") unknown_plugin(p, "area (inside a shape), constant");
+        if (p.type != "constant" && p.type != "envmap") unknown_plugin(p, "area (inside a shape), constant, envmap");
         if (scene.environment >= 0) src.fail_at(p.line, p.where, "only one environment emitter is supported");
-        Emitter e = read_emitter_props(p, EmitterKind::Constant);
+        Emitter e = p.type == "envmap" ? read_envmap(p) : read_emitter_props(p, EmitterKind::Constant);
         register_id(p.id, p.tag, p.line);
         scene.environment = int(scene.emitters.size());
         scene.emitters.push_back(e);
     }
+    /// Mitsuba 3 envmap: filename (relative to the XML), scale, to_world. The image is loaded
+    /// now, so a missing file is an error at the emitter's line naming the file.
+    Emitter read_envmap(const Plugin& p) {
+        allow_only(p, {"filename", "scale", "to_world"});
+        for (const pugi::xml_node& c : p.children) unexpected_child(p, c);
+        const std::string name = get_string(p, "filename", "");
+        if (name.empty()) src.fail_at(p.line, p.where + ".filename", "missing");
+        const std::string file = fs::absolute(dir / name).lexically_normal().string();
+        Emitter e;
+        e.kind = EmitterKind::EnvMap;
+        e.props = to_props(p);
+        try {
+            e.envmap = EnvMap::load(file, get_transform(p, "to_world"), get_float(p, "scale", 1.f));
+        } catch (const SceneError& err) {
+            fail_value(p, "filename", std::string(err.what()) + " (the environment map; see the scene's SOURCE/README for where to get it)");
+        }
+        e.radiance_rgb = e.envmap->mean_radiance();
+        return e;
+    }
+
     Emitter read_emitter_props(const Plugin& p, EmitterKind kind) {
         allow_only(p, {"radiance"});
         for (const pugi::xml_node& c : p.children) {

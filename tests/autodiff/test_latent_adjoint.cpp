@@ -236,7 +236,9 @@ TEST(LatentAdjoint, RoughnessGradientMatchesFiniteDifferencesInExpectation) {
 namespace {
 
 /// A floor (textured diffuse) and a back wall (textured nonlinear roughplastic) under an area
-/// light; rectangles carry uv in [0, 1]², so g(uv) varies across every pixel.
+/// light and an environment map (the same small image: radiance varies with direction, so the
+/// latent environment's L̃e is scaled by the map's relative luminance); rectangles carry uv in
+/// [0, 1]², so g(uv) varies across every pixel.
 Scene textured_scene() {
     // 4 x 4 linear-RGB texture with distinct luminances (EXR: no sRGB decoding).
     Image tex{4, 4, 3, {}, {"R", "G", "B"}};
@@ -256,7 +258,8 @@ Scene textured_scene() {
         { "id": "wall", "type": "rectangle", "material": "wall", "to_world": [ { "scale": 1.5 }, { "translate": [0, 1.5, -1.5] } ] },
         { "id": "light", "type": "rectangle", "material": { "type": "diffuse", "reflectance": 0 },
           "to_world": [ { "rotate": { "axis": [1, 0, 0], "angle": 90 } }, { "scale": 0.5 }, { "translate": [0, 2.5, 0] } ],
-          "emitter": { "type": "area", "radiance": 5 } } ]
+          "emitter": { "type": "area", "radiance": 5 } } ],
+      "emitters": [ { "type": "envmap", "filename": ")" + tex_path + R"(", "scale": 2 } ]
     })";
     return load_scene(test::write_temp_file("textured.json", json));
 }
@@ -264,9 +267,9 @@ Scene textured_scene() {
 }  // namespace
 
 // Textured latent colours ρ = g(uv)·s + o: the scale and offset slices exist in place of the
-// plain colour, and their path-replay gradients (diffuse, and nonlinear roughplastic whose
+// plain colour, and their path-replay gradients (and the environment map's L̃e) (diffuse, and nonlinear roughplastic whose
 // ∂ρ̃/∂ρ depends on the hit's ρ) match central differences like every other parameter.
-TEST(LatentAdjoint, TextureScaleAndOffsetGradientsMatchFiniteDifferences) {
+TEST(LatentAdjoint, TextureAndEnvMapGradientsMatchFiniteDifferences) {
     Scene scene = textured_scene();
     LatentModel m(scene, Parameterisation::Code, 4);
     std::vector<std::string> names;
@@ -288,6 +291,6 @@ TEST(LatentAdjoint, TextureScaleAndOffsetGradientsMatchFiniteDifferences) {
     // The light is out of view (its L̃a, L̃c, colour have no effect): judge the texture slices.
     const std::set<std::string> exercised = check_all_slices(m, o, 1e-3, 0.25);
     for (const char* want : {"floor.bsdf.reflectance.scale", "floor.bsdf.reflectance.offset", "wall.bsdf.diffuse_reflectance.scale",
-                             "wall.bsdf.diffuse_reflectance.offset"})
+                             "wall.bsdf.diffuse_reflectance.offset", "environment.Le"})
         EXPECT_TRUE(exercised.count(want)) << want << " has only ~0 derivatives";
 }

@@ -261,7 +261,7 @@ TEST(MitsubaXml, UnsupportedFeaturesAreErrors) {
         expect_has(err, msg);
     };
     std::string env = R"(<emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>)";
-    check("envmap.xml", scene_xml("\n" + kQuad + "\n" + env), "envmap", "envmap is not supported yet");
+    check("envmap.xml", scene_xml("\n" + kQuad + "\n" + env), "envmap", "sky.exr: cannot open image file");
     std::string gauss = kSensor;
     gauss.replace(gauss.find("\"box\""), 5, "\"gaussian\"");
     check("gauss.xml", scene_xml(kQuad, gauss), "gaussian", "unsupported, use box or tent");
