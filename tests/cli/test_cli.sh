@@ -67,6 +67,10 @@ if [ -d "$shared/models/taesd3" ]; then
     check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
     check oiiotool "$out/ed/frame_0000_refined.exr" "$out/enc/latent_refined.exr" --fail 0 --failpercent 0 --diff
     check test -s "$out/ed/frame_0000.png"; check test -s "$out/ed/frame_0000_rendered.png"
+    # Another latent resolution than training: the refiner is fully convolutional.
+    "$bin" render "$out/enc" --edit "$out/identity.json" --res 4x3 --spp 2 -q --out "$out/ed_res"
+    check test "$(oiiotool --info "$out/ed_res/frame_0000_refined.exr" | grep -c ' 4 x  *3,')" -eq 1
+    check test "$(oiiotool --info "$out/ed_res/frame_0000.png" | grep -c '32 x  *24,')" -eq 1
     printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move.json"
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --out "$out/ed2"
     check test "$(wc -l < "$out/ed2/metrics.csv")" -eq 3
