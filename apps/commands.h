@@ -46,6 +46,7 @@ struct RenderArgs {
     std::string edit;             ///< edits.json, when `scene` is a fit folder
     bool reference = false;       ///< also path trace + encode each edited frame, write metrics.csv
     int ref_spp = 256;
+    std::string reference_cache;  ///< folder keeping path-traced reference frames for reuse
 };
 int run_render(const RenderArgs& args);
 int run_render_edit(const RenderArgs& args);

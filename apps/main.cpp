@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     render->add_flag("--reference", r.reference, "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv");
     render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")->capture_default_str();
+    render->add_option("--reference-cache", r.reference_cache, "with --reference: keep path-traced frames in this folder and reuse them "
+                                                                "(keyed by edits file name, size, spp, tone and frame)");
     render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
     render->add_option("--spp", r.spp, "samples per pixel (default: the scene's)");
     render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");

@@ -81,22 +81,43 @@ int run_render_edit(const RenderArgs& a) {
         else if (!a.quiet) std::cerr << "note: no LPIPS weights at " << lpips_dir << ": rgb_lpips left empty\n";
     }
     std::ostringstream csv;
-    csv << "frame,t,latent_mse,latent_psnr,rgb_ssim,rgb_lpips" << (refiner ? ",refined_latent_mse,refined_latent_psnr,refined_rgb_ssim,refined_rgb_lpips" : "") << "\n";
-    // Latent and decoded-image errors of one frame against the encoded reference (docs/metrics.md).
+    const char* columns = "latent_mse,latent_psnr,latent_dssim,rgb_mse_x100,rgb_ssim,rgb_lpips";
+    csv << "frame,t," << columns;
+    if (refiner) {
+        std::string c = columns, r;
+        for (size_t p = 0, q; p <= c.size(); p = q + 1) {
+            q = c.find(',', p);
+            if (q == std::string::npos) q = c.size();
+            r += ",refined_" + c.substr(p, q - p);
+        }
+        csv << r;
+    }
+    csv << "\n";
+    // Latent and decoded-image errors of one frame against the encoded reference (docs/metrics.md):
+    // latent MSE, PSNR over the data range 6, D-SSIM = 1 − SSIM (range 6); decoded RGB (clamped
+    // to [0, 1]) MSE × 100, SSIM, LPIPS against the display-mapped reference. Empty when the image
+    // is below a metric's minimum size.
     auto frame_metrics = [&](const std::vector<float>& latent, const std::vector<float>& ref, const std::vector<float>& ref_rgb) {
         double mse = 0;
         for (size_t k = 0; k < ref.size(); ++k) mse += double(latent[k] - ref[k]) * (latent[k] - ref[k]);
         mse /= double(ref.size());
         std::ostringstream o;
         o << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12)) << ",";  // data range 6 (±3)
+        if (w >= kSsimWindow && h >= kSsimWindow) o << 1.0 - ssim(latent.data(), ref.data(), w, h, kLatentChannels, kLatentDataRange);
+        o << ",";
         if (vae) {
             std::vector<float> rgb = vae->decode(latent, w, h);
-            for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
-            if (8 * w >= 11 && 8 * h >= 11) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
+            double rgb_mse = 0;
+            for (size_t k = 0; k < rgb.size(); ++k) {
+                rgb[k] = std::clamp(rgb[k], 0.f, 1.f);
+                rgb_mse += double(rgb[k] - ref_rgb[k]) * (rgb[k] - ref_rgb[k]);
+            }
+            o << 100.0 * rgb_mse / double(rgb.size()) << ",";
+            if (8 * w >= kSsimWindow && 8 * h >= kSsimWindow) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
             o << ",";
             if (lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) o << lpips->distance(rgb, ref_rgb, 8 * w, 8 * h);
         } else {
-            o << ",";
+            o << ",,";
         }
         return o.str();
     };
@@ -126,10 +147,30 @@ int run_render_edit(const RenderArgs& a) {
             if (refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, vae->decode(refined, w, h), {}});
         }
         if (a.reference) {
-            // The edited scene file is not on disk: path trace this Scene directly.
-            std::vector<float> ref_rgb;
-            std::vector<float> ref = encoded_reference_of(scene, 8 * w, 8 * h, a.ref_spp, m.value("ref_tone", "clip"), *vae, true,
-                                                          stem + "_reference.png", &ref_rgb);
+            // The edited scene file is not on disk: path trace this Scene directly, or take the
+            // frame from --reference-cache (experiments compare several fits on one sequence).
+            std::vector<float> ref_rgb, ref;
+            const std::string tone_name = m.value("ref_tone", "clip");
+            fs::path cached;
+            if (!a.reference_cache.empty()) {
+                char key[160];
+                std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s.exr", fs::path(a.edit).stem().string().c_str(), 8 * w, 8 * h, a.ref_spp,
+                              tone_name.c_str(), name);
+                cached = fs::path(a.reference_cache) / key;
+            }
+            if (!cached.empty() && fs::exists(cached)) {
+                Image img = read_image(cached.string());
+                if (img.width != 8 * w || img.height != 8 * h || img.channels != 3) throw std::runtime_error(cached.string() + ": cached reference has the wrong size");
+                ref_rgb = img.data;
+                ref = vae->encode(ref_rgb, 8 * w, 8 * h);
+                write_png_display(stem + "_reference.png", Image{8 * w, 8 * h, 3, ref_rgb, {}});
+            } else {
+                ref = encoded_reference_of(scene, 8 * w, 8 * h, a.ref_spp, tone_name, *vae, true, stem + "_reference.png", &ref_rgb);
+                if (!cached.empty()) {
+                    fs::create_directories(cached.parent_path());
+                    write_exr(cached.string(), Image{8 * w, 8 * h, 3, ref_rgb, {"R", "G", "B"}});
+                }
+            }
             csv << i << "," << t << frame_metrics(latent, ref, ref_rgb);
             if (refiner) csv << frame_metrics(refined, ref, ref_rgb);
             csv << "\n";

@@ -72,8 +72,13 @@ if [ -d "$shared/models/taesd3" ]; then
     check test "$(oiiotool --info "$out/ed_res/frame_0000_refined.exr" | grep -c ' 4 x  *3,')" -eq 1
     check test "$(oiiotool --info "$out/ed_res/frame_0000.png" | grep -c '32 x  *24,')" -eq 1
     printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move.json"
-    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --out "$out/ed2"
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2"
     check test "$(wc -l < "$out/ed2/metrics.csv")" -eq 3
+    check test "$(ls "$out/refs" | wc -l)" -eq 2
+    # From the cache: the same references, so the same metrics.
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2c"
+    check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
+    check grep -q "latent_dssim,rgb_mse_x100" "$out/ed2/metrics.csv"
     check grep -q "rgb_ssim,rgb_lpips,refined_latent_mse" "$out/ed2/metrics.csv"
     printf '{"shapes": [{"id": "nope"}]}' > "$out/bad.json"
     expect_error "nope" "$bin" render "$out/enc" --edit "$out/bad.json" -q --out "$out/ed3"
