@@ -55,7 +55,7 @@ torch::Tensor block(const Weights& w, int i, const torch::Tensor& x) {
     return torch::relu(conv(w, p + "4", y) + x);
 }
 
-class Taesd final : public Vae, public TorchVae {
+class Taesd final : public NchwVae {
 public:
     Taesd(const std::string& dir, const std::string& prefix, const LatentConvention& conv) : m_conv(conv) {
         std::vector<std::pair<std::string, std::vector<int64_t>>> enc, dec;
@@ -74,25 +74,6 @@ public:
         m_dec = load_weights(dir + "/" + prefix + "_decoder.safetensors", dec);
         // Intra-op threads default to 1 here; convolutions dominate, so use the machine.
         at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency())));
-    }
-
-    std::vector<float> encode(const std::vector<float>& rgb, int width, int height) const override {
-        const int f = m_conv.downsample;
-        if (width % f || height % f)
-            throw std::invalid_argument("encode: image " + std::to_string(width) + "x" + std::to_string(height) + " is not a multiple of " +
-                                        std::to_string(f) + " in both axes (crop or pad it first)");
-        if (rgb.size() != size_t(width) * height * 3) throw std::invalid_argument("encode: expected width*height*3 floats");
-        torch::NoGradGuard no_grad;
-        return to_hwc(encode_nchw(torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2})));
-    }
-
-    std::vector<float> decode(const std::vector<float>& latent, int width, int height) const override {
-        const int c = m_conv.channels;
-        if (latent.size() != size_t(width) * height * c)
-            throw std::invalid_argument("decode: expected " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(c) +
-                                        " floats, got " + std::to_string(latent.size()));
-        torch::NoGradGuard no_grad;
-        return to_hwc(decode_nchw(torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c}).permute({0, 3, 1, 2})));
     }
 
     torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {
@@ -122,11 +103,6 @@ public:
     const LatentConvention& convention() const override { return m_conv; }
 
 private:
-    static std::vector<float> to_hwc(const torch::Tensor& nchw) {
-        torch::Tensor t = nchw.permute({0, 2, 3, 1}).contiguous();
-        return std::vector<float>(t.data_ptr<float>(), t.data_ptr<float>() + t.numel());
-    }
-
     LatentConvention m_conv;
     Weights m_enc, m_dec;
 };

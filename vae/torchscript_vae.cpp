@@ -34,7 +34,7 @@ std::string shape_of(const torch::Tensor& t) {
     return s + "]";
 }
 
-class TorchScriptVae final : public Vae, public TorchVae {
+class TorchScriptVae final : public NchwVae {
 public:
     TorchScriptVae(const std::string& encoder, const std::string& decoder, const std::string& config) {
         std::ifstream f(config);
@@ -73,25 +73,6 @@ public:
         at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency())));
     }
 
-    std::vector<float> encode(const std::vector<float>& rgb, int width, int height) const override {
-        const int f = m_conv.downsample;
-        if (width % f || height % f)
-            throw std::invalid_argument("encode: image " + std::to_string(width) + "x" + std::to_string(height) + " is not a multiple of " +
-                                        std::to_string(f) + " in both axes (crop or pad it first)");
-        if (rgb.size() != size_t(width) * height * 3) throw std::invalid_argument("encode: expected width*height*3 floats");
-        torch::NoGradGuard no_grad;
-        return to_hwc(encode_nchw(torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2}).contiguous()));
-    }
-
-    std::vector<float> decode(const std::vector<float>& latent, int width, int height) const override {
-        const int c = m_conv.channels;
-        if (latent.size() != size_t(width) * height * c)
-            throw std::invalid_argument("decode: expected " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(c) +
-                                        " floats, got " + std::to_string(latent.size()));
-        torch::NoGradGuard no_grad;
-        return to_hwc(decode_nchw(torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c}).permute({0, 3, 1, 2}).contiguous()));
-    }
-
     torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {
         torch::Tensor z = run(m_enc, m_encoder_path, rgb * (m_hi - m_lo) + m_lo);
         const int f = m_conv.downsample;
@@ -121,11 +102,6 @@ private:
             throw std::runtime_error(path + ": forward failed: " + e.what_without_backtrace());
         }
     }
-    static std::vector<float> to_hwc(const torch::Tensor& nchw) {
-        torch::Tensor t = nchw.permute({0, 2, 3, 1}).contiguous();
-        return std::vector<float>(t.data_ptr<float>(), t.data_ptr<float>() + t.numel());
-    }
-
     LatentConvention m_conv;
     float m_lo = 0.f, m_hi = 1.f;
     bool m_raw = false;
