@@ -65,8 +65,10 @@ int main(int argc, char** argv) {
     fit->add_option("--lr-period", f.lr_period, "iterations per restart period")->capture_default_str();
     fit->add_option("--patience", f.patience, "early stopping: iterations without improvement of the smoothed loss; 0 = off")->capture_default_str();
     fit->add_option("--min-delta", f.min_delta, "early stopping: smallest improvement that counts")->capture_default_str();
-    fit->add_option("--tone", f.tone, "signed tone curve: clip or reinhard")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
-    fit->add_option("--param", f.param, "parameterisation: code (public code) or paper (paper text)")->check(CLI::IsMember({"code", "paper"}))->capture_default_str();
+    fit->add_option("--tone", f.tone, "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
+        ->check(CLI::IsMember({"clip", "reinhard", "logit"}))->capture_default_str();
+    fit->add_option("--param", f.param, "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
+        ->check(CLI::IsMember({"code", "paper", "classic"}))->capture_default_str();
     fit->add_option("--gate", f.gate, "Ic gate: shadowed (1 - V) or visible (V)")->check(CLI::IsMember({"shadowed", "visible"}))->capture_default_str();
     fit->add_option("--terms", f.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
     fit->add_option("--checkpoint-every", f.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();

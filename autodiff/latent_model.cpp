@@ -8,7 +8,8 @@ namespace lpt {
 Parameterisation parameterisation_from_string(const std::string& s) {
     if (s == "paper") return Parameterisation::Paper;
     if (s == "code") return Parameterisation::Code;
-    throw std::invalid_argument("unknown parameterisation '" + s + "' (known: paper, code)");
+    if (s == "classic") return Parameterisation::Classic;
+    throw std::invalid_argument("unknown parameterisation '" + s + "' (known: paper, code, classic)");
 }
 
 void split_materials_per_shape(Scene& scene) {
@@ -32,6 +33,8 @@ struct SliceSpec {
 SliceSpec spec_for(Parameterisation p, bool reflectance_like) {
     if (p == Parameterisation::Code)
         return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f} : SliceSpec{ParamMap::Identity, -6.f, 6.f, -0.1f, 0.1f};
+    if (p == Parameterisation::Classic)  // non-negative; radiances start small so the render starts inside (0, 1)
+        return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f} : SliceSpec{ParamMap::Identity, 0.f, 1e4f, 0.f, 0.2f};
     return reflectance_like ? SliceSpec{ParamMap::PosNeg, 0.f, 1.f, 0.f, 1.f} : SliceSpec{ParamMap::PosNeg, 0.f, 1e30f, 0.f, 1.f};
 }
 

@@ -21,8 +21,11 @@ using Latent = Spectrum<kLatentChannels>;
 /// in [0, 1]). Code (public implementation): reflectance = sigmoid(raw), init raw U[−1, 1];
 /// radiance-like vectors raw in [−6, 6], init U[−0.1, 0.1]. Roughness alpha is not a signed
 /// vector: sigmoid in both, initialised at the scene file's value.
-enum class Parameterisation { Paper, Code };
-Parameterisation parameterisation_from_string(const std::string& s);  ///< "paper" | "code"
+/// Paper / Code: the two signed parameterisations; Classic: the paper's baseline, every vector
+/// non-negative (reflectances sigmoid in (0, 1), radiances clamped to [0, 1e4]) for a classic
+/// render in [0, 1) that the logit tone curve maps to latent space. docs/params.md.
+enum class Parameterisation { Paper, Code, Classic };
+Parameterisation parameterisation_from_string(const std::string& s);  ///< "paper" | "code" | "classic"
 
 class LatentModel {
 public:

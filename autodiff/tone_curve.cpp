@@ -31,6 +31,7 @@ float curve(ToneCurve kind, float a) {
         case ToneCurve::Reinhard:
             return k_reinhard_scale * std::pow(a / (1.0f + a), k_gamma);
         case ToneCurve::None:
+        case ToneCurve::Logit:  // handled in tone()
             return a;
     }
     return a;
@@ -53,6 +54,7 @@ float d_curve(ToneCurve kind, float a) {
             return k_reinhard_scale * k_gamma * std::pow(y, k_gamma - 1.0f) * inv * inv;
         }
         case ToneCurve::None:
+        case ToneCurve::Logit:  // handled in d_tone()
             return 1.0f;
     }
     return 1.0f;
@@ -64,7 +66,8 @@ ToneCurve parse_tone_curve(const std::string& name) {
     if (name == "clip") return ToneCurve::Clip;
     if (name == "reinhard") return ToneCurve::Reinhard;
     if (name == "none") return ToneCurve::None;
-    throw std::invalid_argument("unknown tone curve '" + name + "' (expected clip, reinhard or none)");
+    if (name == "logit") return ToneCurve::Logit;
+    throw std::invalid_argument("unknown tone curve '" + name + "' (expected clip, reinhard, none or logit)");
 }
 
 const char* to_string(ToneCurve curve) {
@@ -72,17 +75,30 @@ const char* to_string(ToneCurve curve) {
         case ToneCurve::Clip: return "clip";
         case ToneCurve::Reinhard: return "reinhard";
         case ToneCurve::None: return "none";
+        case ToneCurve::Logit: return "logit";
     }
     return "none";
 }
 
 float tone(ToneCurve kind, float x) {
+    if (kind == ToneCurve::Logit) {
+        const float y = std::clamp(x, k_logit_eps, 1.0f - k_logit_eps);
+        return std::log(y / (1.0f - y));
+    }
     // Odd extension, docs/fitting.md (1): the negative half mirrors the positive one so that
     // the sign of the latent survives tone mapping.
     return x < 0.0f ? -curve(kind, -x) : curve(kind, x);
 }
 
 float d_tone(ToneCurve kind, float x) {
+    // Logit: 1 / (x (1 − x)) inside [eps, 1 − eps], 0 where the clamp holds (the true
+    // derivative). A surrogate slope there (the clamp's, ~1e4) let the few pixels that see a
+    // light directly (x > 1) pin the light's radiance: measured, the fit then stalls at Huber
+    // 3.6 on the Cornell box.
+    if (kind == ToneCurve::Logit) {
+        if (x < k_logit_eps || x > 1.0f - k_logit_eps) return 0.0f;
+        return 1.0f / (x * (1.0f - x));
+    }
     // d/dx [−c(−x)] = c'(−x): the derivative of an odd function is even.
     return d_curve(kind, std::fabs(x));
 }

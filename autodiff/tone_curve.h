@@ -11,13 +11,19 @@ enum class ToneCurve {
     Clip,      ///< c(x) = 3 · clamp(x, 0, 3)^(1/2.2)          docs/fitting.md (2)
     Reinhard,  ///< c(x) = 4 · (x / (1 + x))^(1/2.2)           docs/fitting.md (4)
     None,      ///< identity
+    /// The paper's baseline: a classic non-negative render x in [0, 1) mapped to latent space by
+    /// logit(clamp(x, eps, 1 − eps)), eps = 1e-4 (not odd: the classic render is never
+    /// negative). docs/fitting.md "Baseline".
+    Logit,
 };
 
 /// Below this |x| the derivative is evaluated at |x| = eps: c'(x) ~ x^(1/2.2 − 1) is infinite
 /// at 0. docs/fitting.md (6).
 inline constexpr float k_tone_grad_eps = 1e-4f;
 
-/// "clip", "reinhard" or "none" (exact, lower case); std::invalid_argument otherwise.
+inline constexpr float k_logit_eps = 1e-4f;
+
+/// "clip", "reinhard", "none" or "logit" (exact, lower case); std::invalid_argument otherwise.
 ToneCurve parse_tone_curve(const std::string& name);
 /// Inverse of parse_tone_curve.
 const char* to_string(ToneCurve curve);

@@ -34,6 +34,23 @@ TEST(ToneCurve, HandValues) {
     for (ToneCurve c : {ToneCurve::Clip, ToneCurve::Reinhard, ToneCurve::None}) EXPECT_EQ(tone(c, 0.0f), 0.0f);
 }
 
+// The baseline's logit: hand values, the clamp, and its derivative (exact inside, 0 outside).
+TEST(ToneCurve, LogitBaseline) {
+    EXPECT_FLOAT_EQ(tone(ToneCurve::Logit, 0.5f), 0.0f);
+    EXPECT_NEAR(tone(ToneCurve::Logit, 0.75f), std::log(3.0f), 1e-6f);
+    EXPECT_NEAR(tone(ToneCurve::Logit, 0.0f), std::log(k_logit_eps / (1 - k_logit_eps)), 1e-4f);
+    EXPECT_EQ(tone(ToneCurve::Logit, -2.0f), tone(ToneCurve::Logit, 0.0f));
+    EXPECT_EQ(tone(ToneCurve::Logit, 7.0f), tone(ToneCurve::Logit, 1.0f));
+    for (float x : {0.01f, 0.2f, 0.5f, 0.9f, 0.99f}) {
+        const float h = 1e-3f * std::min(x, 1 - x);
+        const double fd = (double(tone(ToneCurve::Logit, x + h)) - double(tone(ToneCurve::Logit, x - h))) / (2.0 * h);
+        EXPECT_NEAR(d_tone(ToneCurve::Logit, x), fd, 3e-3 * fd) << x;  // float rounding of 1 − y near 1
+    }
+    EXPECT_EQ(d_tone(ToneCurve::Logit, 0.0f), 0.0f);  // the clamp holds: no slope
+    EXPECT_EQ(d_tone(ToneCurve::Logit, 1.5f), 0.0f);
+    EXPECT_EQ(parse_tone_curve("logit"), ToneCurve::Logit);
+}
+
 TEST(ToneCurve, OddValueEvenDerivative) {
     for (ToneCurve c : {ToneCurve::Clip, ToneCurve::Reinhard, ToneCurve::None})
         for (float x : {1e-5f, 1e-4f, 0.3f, 1.0f, 2.9f, 3.0f, 4.2f, 50.0f}) {
