@@ -53,8 +53,8 @@ CONFIGS = [("e", "Ĩe"), ("ea", "+Ĩa"), ("eac", "+Ĩc"), ("eac+refiner", "+refi
 # (--param classic --tone logit), Ĩe only, the same refiner; its lr is raised to 1.0 because
 # its radiances must grow from ~0.1 to ~10 (measured on the Cornell box: Huber 2.6 at lr 0.05,
 # 1.3 at lr 1.0 after 600 iterations).
-FITS = {"e": ("e", [], False), "ea": ("ea", [], False), "eac": ("eac", [], True),
-        "baseline": ("e", ["--param", "classic", "--tone", "logit", "--lr", "1.0"], True)}
+FITS = {"e": ("e", [], False, 0.05), "ea": ("ea", [], False, 0.05), "eac": ("eac", [], True, 0.05),
+        "baseline": ("e", ["--param", "classic", "--tone", "logit"], True, 1.0)}
 
 
 def run(cmd, log):
@@ -126,6 +126,7 @@ def main():
     ap.add_argument("--fit-iterations", type=int, default=None)
     ap.add_argument("--refiner-iterations", type=int, default=None)
     ap.add_argument("--spp", type=int, default=64, help="latent samples per pixel of the edited frames")
+    ap.add_argument("--redo", action="store_true", help="recompute everything (default: reuse finished fits and edit renders in --out)")
     a = ap.parse_args()
     q = a.quick
     image_res = a.image_res or (128 if q else 256)
@@ -153,14 +154,18 @@ def main():
         sdir = os.path.join(a.out, scene)
         os.makedirs(sdir, exist_ok=True)
         times = {}
-        for name, (terms, extra, refine) in FITS.items():
+        for name, (terms, extra, refine, lr) in FITS.items():
             fit_dir = os.path.join(sdir, "fit_" + name)
             cmd = [a.bin, "fit", scene_file, "--encode", "--encode-res", f"{image_res}x{image_res}", "--ref-spp", str(ref_spp),
-                   "--iterations", str(fit_its), "--spp", "4", "--lr", "0.05", "--lr-period", str(fit_its), "--final-spp", "64",
+                   "--iterations", str(fit_its), "--spp", "4", "--lr", str(lr), "--lr-period", str(fit_its), "--final-spp", "64",
                    "--terms", terms, "-q", "--out", fit_dir] + extra
             cmd += ["--refiner-iterations", str(ref_its)] if refine else ["--no-refiner"]
             for d in defines:
                 cmd += ["-D", d]
+            done = os.path.exists(os.path.join(fit_dir, "fit.json")) and (not refine or os.path.exists(os.path.join(fit_dir, "metrics.json")))
+            if done and not a.redo:  # a finished fit from an interrupted or earlier run
+                print(f"[{scene}] fit {name}: done already ({fit_dir})", flush=True)
+                continue
             print(f"[{scene}] fit {name} ...", flush=True)
             times["fit_" + name] = run(cmd, log)
         with open(os.path.join(sdir, "fit_eac", "metrics.json")) as f:
@@ -181,6 +186,10 @@ def main():
             rows = {}
             for name in FITS:
                 out = os.path.join(sdir, f"{kind}_{name}")
+                mcsv = os.path.join(out, "metrics.csv")
+                if os.path.exists(mcsv) and not a.redo and len(read_metrics(mcsv)) == (frames or 60):
+                    rows[name] = read_metrics(mcsv)
+                    continue
                 print(f"[{scene}] {kind} edit with fit {name} ...", flush=True)
                 run([a.bin, "render", os.path.join(sdir, "fit_" + name), "--edit", edit_file, "--reference", "--ref-spp", str(ref_spp),
                      "--reference-cache", os.path.join(sdir, "refs"), "--spp", str(a.spp), "-q", "--out", out], log)
