@@ -61,9 +61,11 @@ struct BenchArgs {
     std::string fit_scene;        ///< default: ../shared/scenes/cbox/cbox_specular.xml, else ours
     int fit_res = 128;
     std::vector<int> fit_spp{16, 64, 256};
+    std::string equal_error;      ///< fit folder: latent vs RGB time to equal error
 };
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);
+int run_bench_equal_error(const BenchArgs& args);
 
 /// Stage 2 on a fit folder: trains the refiner on the folder's final render (latent.exr, aov.exr)
 /// against target.exr (and reference_rgb.exr for LPIPS when present).
@@ -120,6 +122,9 @@ int run_metrics(const MetricsArgs&);
 std::string default_vae_dir(const std::string& dir);
 /// ../shared (LATENTPT_SHARED overrides) + "/models/lpips" unless `dir` is given.
 std::string default_lpips_dir(const std::string& dir);
+/// The paper's display mapping for references: clip to [0, 1] (or |x|/(1+|x|) for "reinhard"),
+/// then x^(1/2.2).
+float display_value(float v, const std::string& tone);
 /// Path-traced RGB of `scene` at width x height, tone-mapped as the paper does for its
 /// references (clip or reinhard, then gamma 1/2.2), encoded by `vae`. `display_rgb`, if given,
 /// receives the tone-mapped RGB that was encoded.

@@ -46,6 +46,9 @@ int main(int argc, char** argv) {
     bench->add_option("--fit-scene", b.fit_scene, "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)");
     bench->add_option("--fit-res", b.fit_res, "latent resolution for --fit")->capture_default_str();
     bench->add_option("--fit-spp", b.fit_spp, "samples per pixel per iteration for --fit")->capture_default_str();
+    bench->add_option("--equal-error", b.equal_error, "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
+                                                      "the same latent error, and latent + decode vs RGB for the same image error")
+        ->check(CLI::ExistingDirectory);
 
     FitArgs f;
     std::vector<std::string> fit_defines;
@@ -146,7 +149,7 @@ int main(int argc, char** argv) {
             if (!r.edit.empty()) return run_render_edit(r);
             return run_render(r);
         }
-        if (*bench) return b.fit ? run_bench_fit(b) : run_bench(b);
+        if (*bench) return !b.equal_error.empty() ? run_bench_equal_error(b) : b.fit ? run_bench_fit(b) : run_bench(b);
         if (*encode) return run_encode(v);
         if (*decode) return run_decode(v);
         if (*viz) return run_viz(v);

@@ -4,6 +4,7 @@
 // per-frame latent errors in metrics.csv. With the fit's refiner.pt, each frame is also refined
 // (frame_NNNN_refined.exr) and frame_NNNN.png shows the refined latent decoded.
 #include "apps/commands.h"
+#include "apps/fit_folder.h"
 #include "autodiff/fit.h"
 #include "core/image_io.h"
 #include "core/scene_edit.h"
@@ -29,33 +30,13 @@ int run_render_edit(const RenderArgs& a) {
     const fs::path dir(a.scene);
     if (!fs::is_directory(dir)) throw std::runtime_error(a.scene + ": --edit needs a fit folder (made by latentpt fit)");
     const std::string manifest_path = (dir / "fit.json").string();
-    std::ifstream mf(manifest_path);
-    if (!mf) throw std::runtime_error(manifest_path + ": missing: not a latentpt fit folder");
-    nlohmann::json m;
-    try {
-        m = nlohmann::json::parse(mf);
-    } catch (const nlohmann::json::exception& e) {
-        throw std::runtime_error(manifest_path + ": malformed: " + e.what());
-    }
-    std::map<std::string, std::string> defines = m.value("defines", std::map<std::string, std::string>{});
-    for (const auto& [k, v] : a.defines) defines[k] = v;
-    Scene scene = load_scene(m.at("scene").get<std::string>(), defines);
-    LatentModel model(scene, parameterisation_from_string(m.value("param", "code")), 0);
-    const std::string params_path = (dir / "params.json").string();
-    std::ifstream pf(params_path);
-    if (!pf) throw std::runtime_error(params_path + ": missing");
-    std::stringstream ps;
-    ps << pf.rdbuf();
-    model.params().load_json(ps.str(), params_path);
-    model.terms().gate = m.value("gate", "shadowed") == "visible" ? OcclusionGate::Visible : OcclusionGate::Shadowed;
-    const std::string terms = m.value("terms", "eac");
-    model.terms().emission = terms.find('e') != std::string::npos;
-    model.terms().ambient = terms.find('a') != std::string::npos;
-    model.terms().occlusion = terms.find('c') != std::string::npos;
-    model.sync();
-    const ToneCurve tone = parse_tone_curve(m.value("tone", "clip"));
+    FitFolder fit = load_fit_folder(a.scene, a.defines);
+    const nlohmann::json& m = fit.manifest;
+    Scene& scene = *fit.scene;
+    LatentModel& model = *fit.model;
+    const ToneCurve tone = fit.tone;
 
-    int w = m.at("latent_width"), h = m.at("latent_height");
+    int w = fit.latent_width, h = fit.latent_height;
     if (!a.res.empty()) parse_resolution(a.res, w, h);  // latent resolution may differ from training
     EditSequence edits = load_edits(a.edit, scene);
     std::vector<TriangleMesh> original;

@@ -33,13 +33,12 @@ std::string default_lpips_dir(const std::string& dir) {
     return (env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared") + "/models/lpips";
 }
 
-namespace {
-
-/// The paper's display mapping for references: clip to [0, 1] or |x|/(1+|x|), then x^(1/2.2).
-float display(float v, const std::string& tone) {
+float display_value(float v, const std::string& tone) {
     v = tone == "reinhard" ? std::abs(v) / (1.f + std::abs(v)) : std::clamp(v, 0.f, 1.f);
     return std::pow(v, 1.f / 2.2f);
 }
+
+namespace {
 
 std::vector<float> rgb_of(const Image& img, const std::string& path) {
     if (img.channels < 3) throw std::runtime_error(path + ": needs 3 channels (RGB), has " + std::to_string(img.channels));
@@ -94,7 +93,7 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
     o.seed = 0x5eed;
     RenderStats st;
     std::vector<float> rgb = render_path<3>(scene, spectra, o, &st).develop();
-    for (float& v : rgb) v = display(v, tone);
+    for (float& v : rgb) v = display_value(v, tone);
     if (!quiet) std::cerr << "reference: " << width << "x" << height << " at " << spp << " spp in " << st.seconds << " s\n";
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
     if (display_rgb) *display_rgb = rgb;

@@ -24,7 +24,8 @@ view and a novel view (the camera edit's last keyframe), <scene>_convergence_<vi
 The paper's baseline (a classic non-negative render in [0, 1) + logit + the same refiner) is a
 fourth fit (--param classic --tone logit --terms e) in every table.
 
-Not yet here (issue 6): the equal-error runtime experiment.
+Equal-error runtime: `latentpt bench --equal-error <fitdir>` on the eac fit, its output kept in
+summary.md.
 """
 import argparse
 import base64
@@ -230,6 +231,12 @@ def main():
                 r = read_metrics(os.path.join(out, "metrics.csv"))[0]
                 conv[view][spp] = {k: float(r[k] or "nan") for k in ("latent_dssim", "rgb_lpips", "refined_latent_dssim", "refined_rgb_lpips")}
         summary[scene]["convergence"] = conv
+        # Equal-error runtime: latent renderer vs RGB path tracing (+ VAE), timed in one process.
+        print(f"[{scene}] equal-error runtime ...", flush=True)
+        r = subprocess.run([a.bin, "bench", "--equal-error", os.path.join(sdir, "fit_eac")], capture_output=True, text=True)
+        if r.returncode != 0:
+            sys.exit(f"experiment: bench --equal-error failed: {r.stderr}")
+        summary[scene]["equal_error"] = r.stdout
 
     # Tables (markdown) and plots.
     colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
@@ -263,6 +270,9 @@ def main():
                                  ("rgb_lpips", "LPIPS", "#ff7f0e"), ("refined_rgb_lpips", "LPIPS refined", "#d62728"))], "error")
                 with open(os.path.join(a.out, f"{scene}_convergence_{view}.svg"), "w") as f:
                     f.write(svg)
+        if "equal_error" in s:
+            md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
+                   s["equal_error"].rstrip(), "```"]
         md.append("")
     if failures:
         md += ["## Ordering check failed", ""] + [f"- {x}" for x in failures]
