@@ -77,7 +77,7 @@ int run_bench_equal_error(const BenchArgs& a) {
         o.spp = 1;
         render_toned(*fit.model, o, fit.tone);
     }
-    for (int spp = 1; spp <= 256; spp *= 2) {
+    for (int spp = 1; spp <= std::max(1, a.max_spp / 4); spp *= 2) {
         RenderOptions o = RenderOptions::from_scene(*fit.scene);
         o.width = w;
         o.height = h;
@@ -96,7 +96,7 @@ int run_bench_equal_error(const BenchArgs& a) {
         lat.push_back(p);
         std::printf("%-8s %6d %10.4f %10.4f %12.5f %12.6f\n", "latent", spp, p.render_s, p.vae_s, p.latent_mse, p.rgb_mse);
     }
-    for (int spp = 1; spp <= 1024; spp *= 2) {
+    for (int spp = 1; spp <= a.max_spp; spp *= 2) {
         RenderOptions o = RenderOptions::from_scene(*fit.scene);
         o.width = W;
         o.height = H;

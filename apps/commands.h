@@ -62,6 +62,7 @@ struct BenchArgs {
     int fit_res = 128;
     std::vector<int> fit_spp{16, 64, 256};
     std::string equal_error;      ///< fit folder: latent vs RGB time to equal error
+    int max_spp = 1024;           ///< --equal-error: highest RGB spp (latent: a quarter of it)
 };
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);

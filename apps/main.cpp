@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
     bench->add_option("--equal-error", b.equal_error, "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
                                                       "the same latent error, and latent + decode vs RGB for the same image error")
         ->check(CLI::ExistingDirectory);
+    bench->add_option("--max-spp", b.max_spp, "with --equal-error: highest RGB spp (latent side: a quarter)")->capture_default_str();
 
     FitArgs f;
     std::vector<std::string> fit_defines;

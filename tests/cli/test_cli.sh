@@ -80,6 +80,8 @@ if [ -d "$shared/models/taesd3" ]; then
     check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
     check grep -q "latent_dssim,rgb_mse_x100" "$out/ed2/metrics.csv"
     check grep -q "rgb_ssim,rgb_lpips,refined_latent_mse" "$out/ed2/metrics.csv"
+    check sh -c "'$bin' bench --equal-error '$out/enc' --max-spp 16 | grep -q 'latent space, MSE'"
+    expect_error "reference_rgb.exr" "$bin" bench --equal-error "$out/fit"
     printf '{"shapes": [{"id": "nope"}]}' > "$out/bad.json"
     expect_error "nope" "$bin" render "$out/enc" --edit "$out/bad.json" -q --out "$out/ed3"
     expect_error "fit.json" "$bin" render "$out" --edit "$out/identity.json" -q --out "$out/ed4"
