@@ -9,9 +9,11 @@ namespace lpt {
 class SceneError : public std::runtime_error {
 public:
     SceneError(const std::string& file, const std::string& field, const std::string& message, int line = -1)
-        : std::runtime_error(format(file, field, message, line)), m_file(file), m_field(field) {}
+        : std::runtime_error(format(file, field, message, line)), m_file(file), m_field(field), m_message(message), m_line(line) {}
     const std::string& file() const { return m_file; }
     const std::string& field() const { return m_field; }
+    /// The same error with `more` appended to its message (e.g. which shapes use a material).
+    SceneError with_note(const std::string& more) const { return SceneError(m_file, m_field, m_message + more, m_line); }
 
 private:
     static std::string format(const std::string& file, const std::string& field, const std::string& msg, int line) {
@@ -20,7 +22,8 @@ private:
         if (!field.empty()) s += ": field '" + field + "'";
         return s + ": " + msg;
     }
-    std::string m_file, m_field;
+    std::string m_file, m_field, m_message;
+    int m_line;
 };
 
 }  // namespace lpt

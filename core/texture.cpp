@@ -45,14 +45,14 @@ std::shared_ptr<const BitmapData> decode(const std::string& path, bool raw) {
         // Exact per-code conversion: a 256-entry table instead of float rounding of v/255.
         std::vector<uint8_t> bytes(px.size());
         if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, bytes.data()))
-            throw SceneError(path, "", "cannot decode image: " + in->geterror());
+            throw SceneError(path, "", "cannot decode image (truncated or corrupt?): " + in->geterror());
         std::array<float, 256> lut;
         for (int i = 0; i < 256; ++i) lut[i] = float(srgb ? srgb_to_linear(i / 255.0) : i / 255.0);
         for (size_t i = 0; i < px.size(); ++i) px[i] = lut[bytes[i]];
     } else {
         // Other integer types come back normalised to [0, 1]; floats as stored.
         if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data()))
-            throw SceneError(path, "", "cannot decode image: " + in->geterror());
+            throw SceneError(path, "", "cannot decode image (truncated or corrupt?): " + in->geterror());
         if (srgb)
             for (float& v : px) v = float(srgb_to_linear(v));
     }

@@ -338,11 +338,16 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
     }
     // Validate every material once, now, so errors point at the file before rendering starts.
     // A bitmap under a key its BSDF reads as a plain colour gets a message saying so.
-    for (const Props& m : scene.materials) {
+    for (size_t mi = 0; mi < scene.materials.size(); ++mi) {
+        const Props& m = scene.materials[mi];
         try {
             make_bsdf<3>(m);
         } catch (const SceneError& e) {
-            throw explain_texture_error(m, e);
+            // Name the shapes too: a material (and its texture) may serve several.
+            std::string users;
+            for (const Shape& s : scene.shapes)
+                if (s.material == int(mi)) users += (users.empty() ? "" : ", ") + std::string("'") + s.id + "'";
+            throw explain_texture_error(m, e).with_note(users.empty() ? std::string() : " (material of shape " + users + ")");
         }
     }
     scene.build();

@@ -173,6 +173,15 @@ TEST(Texture, MissingOrBadFilesNameTheFile) {
     std::string err = error_of([&] { texture_from_props(owner, "reflectance", Eigen::Array3f::Zero()); });
     expect_has(err, "materials.wood.reflectance.filename");
     expect_has(err, "no-such-texture.png");
+
+    // Through a scene file: the error also names the shapes that use the material.
+    const std::string scene = test::write_temp_file("missing_tex.json", R"({"camera": {"fov": 40},
+      "materials": {"wood": {"type": "diffuse", "reflectance": {"type": "bitmap", "filename": ")" + missing + R"("}}},
+      "shapes": [{"id": "desk", "type": "rectangle", "material": "wood"}, {"id": "chair", "type": "rectangle", "material": "wood"}]})");
+    err = error_of([&] { load_scene(scene); });
+    expect_has(err, "missing_tex.json");
+    expect_has(err, "no-such-texture.png");
+    expect_has(err, "'desk', 'chair'");
 }
 
 TEST(Texture, CacheSharesDataAndNoticesRewrites) {
