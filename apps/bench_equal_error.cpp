@@ -8,6 +8,7 @@
 // spp at or below it. docs/performance.md.
 #include "apps/commands.h"
 #include "apps/fit_folder.h"
+#include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "integrators/path.h"
 #include "vae/vae.h"
@@ -24,14 +25,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-double mse(const std::vector<float>& a, const std::vector<float>& b, bool clamp01 = false) {
-    double s = 0;
-    for (size_t i = 0; i < a.size(); ++i) {
-        const double x = clamp01 ? std::clamp(a[i], 0.f, 1.f) : a[i];
-        s += (x - b[i]) * (x - b[i]);
-    }
-    return s / double(a.size());
-}
+double mse(const std::vector<float>& a, const std::vector<float>& b) { return mse_loss(a.data(), b.data(), a.size()); }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -62,7 +56,7 @@ int run_bench_equal_error(const BenchArgs& a) {
     const Image ref_rgb = read_image((dir / "reference_rgb.exr").string());
     if (target.width != w || target.height != h || ref_rgb.width != W || ref_rgb.height != H || ref_rgb.channels != 3)
         throw std::runtime_error(a.equal_error + ": target.exr / reference_rgb.exr do not match the fit's latent size");
-    auto vae = open_vae(manifest_vae((dir / "fit.json").string()));
+    auto vae = open_vae(fit.vae);
     const SceneSpectra<3> rgb_spectra = SceneSpectra<3>::from_description(*fit.scene);
     const uint64_t seed = 1;  // the reference used 0x5eed: independent samples
 
@@ -91,8 +85,9 @@ int run_bench_equal_error(const BenchArgs& a) {
         t0 = std::chrono::steady_clock::now();
         std::vector<float> img = vae->decode(latent, w, h);
         p.vae_s = seconds_since(t0);
+        for (float& v : img) v = std::clamp(v, 0.f, 1.f);  // judged as displayed, like the references
         p.latent_mse = mse(latent, target.data);
-        p.rgb_mse = mse(img, ref_rgb.data, true);
+        p.rgb_mse = mse(img, ref_rgb.data);
         lat.push_back(p);
         std::printf("%-8s %6d %10.4f %10.4f %12.5f %12.6f\n", "latent", spp, p.render_s, p.vae_s, p.latent_mse, p.rgb_mse);
     }

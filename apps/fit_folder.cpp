@@ -39,6 +39,7 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
         f.latent_width = m.at("latent_width");
         f.latent_height = m.at("latent_height");
         f.ref_tone = m.value("ref_tone", "clip");
+        f.vae = vae_source_of(m);
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(manifest_path + ": " + e.what());
     }

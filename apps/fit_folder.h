@@ -2,6 +2,7 @@
 // latent model with the fitted parameters, terms, gate and tone curve, and the latent size.
 // Shared by `render <fitdir> --edit` and `bench --equal-error`.
 #pragma once
+#include "apps/commands.h"
 #include "autodiff/fit.h"
 #include "autodiff/latent_model.h"
 #include "autodiff/tone_curve.h"
@@ -21,7 +22,11 @@ struct FitFolder {
     ToneCurve tone = ToneCurve::Clip;
     int latent_width = 0, latent_height = 0;
     std::string ref_tone = "clip";
+    VaeSource vae;                           ///< the VAE the fit used
 };
+
+/// The VAE recorded in a parsed fit.json (defaults resolved); manifest_vae reads the file.
+VaeSource vae_source_of(const nlohmann::json& manifest);
 
 /// Throws std::runtime_error naming the file for a missing or malformed fit.json / params.json.
 /// `defines` override the fit's own -D values.

@@ -3,6 +3,7 @@
 // curve and metrics.json (decoded rendered / refined / VAE round trip against the reference).
 #include "apps/commands.h"
 #include "autodiff/latent_model.h"
+#include "autodiff/loss.h"
 #include "integrators/aov.h"
 #include "core/image_io.h"
 #include "refiner/refiner.h"
@@ -34,22 +35,13 @@ Image read_checked(const fs::path& p, int channels, int w, int h) {
 
 /// RGB metrics of a decoded latent against the reference image (both in [0, 1] display values).
 nlohmann::json rgb_metrics(std::vector<float> rgb, const std::vector<float>& ref, int w, int h, const Lpips* lpips) {
-    double mse = 0;
-    for (size_t i = 0; i < rgb.size(); ++i) {
-        rgb[i] = std::clamp(rgb[i], 0.f, 1.f);
-        mse += double(rgb[i] - ref[i]) * (rgb[i] - ref[i]);
-    }
-    mse /= double(rgb.size());
-    nlohmann::json j = {{"rgb_mse_x100", 100.0 * mse}};
+    for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+    nlohmann::json j = {{"rgb_mse_x100", 100.0 * mse_loss(rgb.data(), ref.data(), rgb.size())}};
     if (lpips && w >= Lpips::kMinSize && h >= Lpips::kMinSize) j["rgb_lpips"] = lpips->distance(rgb, ref, w, h);
     return j;
 }
 
-double latent_mse(const std::vector<float>& a, const std::vector<float>& b) {
-    double s = 0;
-    for (size_t i = 0; i < a.size(); ++i) s += double(a[i] - b[i]) * (a[i] - b[i]);
-    return s / double(a.size());
-}
+double latent_mse(const std::vector<float>& a, const std::vector<float>& b) { return mse_loss(a.data(), b.data(), a.size()); }
 
 }  // namespace
 
@@ -139,13 +131,12 @@ int run_refine(const RefineArgs& a) {
     o.checkpoint_every = a.checkpoint_every;
     o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();
     o.resume = a.resume && fs::exists(o.checkpoint_path);
-    const int start_it = 0;
     double last_print = -1;
     auto on_iteration = [&](const RefinerRecord& r) {
         if (a.quiet) return true;
         if (r.seconds - last_print < 0.25 && r.iteration + 1 < o.iterations) return true;
         last_print = r.seconds;
-        const double rate = (r.iteration + 1 - start_it) / std::max(1e-9, r.seconds);
+        const double rate = (r.iteration + 1) / std::max(1e-9, r.seconds);
         std::fprintf(stderr, "\r[refine] it %d/%d | loss %.4f (smoothed %.4f; mse %.4f dssim %.4f lpips %.4f) | %.1f it/s | ETA %.0f s   ",
                      r.iteration + 1, o.iterations, r.loss, r.smoothed, r.mse, r.dssim, r.lpips, rate, (o.iterations - r.iteration - 1) / rate);
         return true;

@@ -6,6 +6,7 @@
 #include "apps/commands.h"
 #include "apps/fit_folder.h"
 #include "autodiff/fit.h"
+#include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "core/scene_edit.h"
 #include "core/scene_loader.h"
@@ -29,9 +30,7 @@ namespace fs = std::filesystem;
 int run_render_edit(const RenderArgs& a) {
     const fs::path dir(a.scene);
     if (!fs::is_directory(dir)) throw std::runtime_error(a.scene + ": --edit needs a fit folder (made by latentpt fit)");
-    const std::string manifest_path = (dir / "fit.json").string();
     FitFolder fit = load_fit_folder(a.scene, a.defines);
-    const nlohmann::json& m = fit.manifest;
     Scene& scene = *fit.scene;
     LatentModel& model = *fit.model;
     const ToneCurve tone = fit.tone;
@@ -42,7 +41,7 @@ int run_render_edit(const RenderArgs& a) {
     std::vector<TriangleMesh> original;
     for (const Shape& s : scene.shapes) original.push_back(s.mesh);
     const Camera original_camera = scene.camera;
-    const VaeSource vae_source = manifest_vae(manifest_path);
+    const VaeSource& vae_source = fit.vae;
     const bool have_vae = vae_present(vae_source);
     if (a.reference && !have_vae) throw std::runtime_error("--reference needs the fit's VAE to encode references; not found: " + default_vae_dir(vae_source.dir));
     if (!have_vae && !a.quiet) std::cerr << "note: the fit's VAE is not here (" << default_vae_dir(vae_source.dir) << "): writing latents only\n";
@@ -79,21 +78,15 @@ int run_render_edit(const RenderArgs& a) {
     // to [0, 1]) MSE × 100, SSIM, LPIPS against the display-mapped reference. Empty when the image
     // is below a metric's minimum size.
     auto frame_metrics = [&](const std::vector<float>& latent, const std::vector<float>& ref, const std::vector<float>& ref_rgb) {
-        double mse = 0;
-        for (size_t k = 0; k < ref.size(); ++k) mse += double(latent[k] - ref[k]) * (latent[k] - ref[k]);
-        mse /= double(ref.size());
+        const double mse = mse_loss(latent.data(), ref.data(), ref.size());
         std::ostringstream o;
         o << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12)) << ",";  // data range 6 (±3)
         if (w >= kSsimWindow && h >= kSsimWindow) o << 1.0 - ssim(latent.data(), ref.data(), w, h, kLatentChannels, kLatentDataRange);
         o << ",";
         if (vae) {
             std::vector<float> rgb = vae->decode(latent, w, h);
-            double rgb_mse = 0;
-            for (size_t k = 0; k < rgb.size(); ++k) {
-                rgb[k] = std::clamp(rgb[k], 0.f, 1.f);
-                rgb_mse += double(rgb[k] - ref_rgb[k]) * (rgb[k] - ref_rgb[k]);
-            }
-            o << 100.0 * rgb_mse / double(rgb.size()) << ",";
+            for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+            o << 100.0 * mse_loss(rgb.data(), ref_rgb.data(), rgb.size()) << ",";
             if (8 * w >= kSsimWindow && 8 * h >= kSsimWindow) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
             o << ",";
             if (lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) o << lpips->distance(rgb, ref_rgb, 8 * w, 8 * h);
@@ -131,7 +124,7 @@ int run_render_edit(const RenderArgs& a) {
             // The edited scene file is not on disk: path trace this Scene directly, or take the
             // frame from --reference-cache (experiments compare several fits on one sequence).
             std::vector<float> ref_rgb, ref;
-            const std::string tone_name = m.value("ref_tone", "clip");
+            const std::string& tone_name = fit.ref_tone;
             fs::path cached;
             if (!a.reference_cache.empty()) {
                 char key[160];

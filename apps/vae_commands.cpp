@@ -1,6 +1,7 @@
 // `latentpt encode | decode | viz`, and the encoded RGB reference that `fit --encode` fits to.
 // This file and fit's target path are where the apps touch the VAE (libtorch stays in vae/).
 #include "apps/commands.h"
+#include "apps/fit_folder.h"
 #include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
@@ -63,12 +64,14 @@ bool vae_present(const VaeSource& s) {
 }
 
 VaeSource manifest_vae(const std::string& path) {
-    nlohmann::json m;
     try {
-        m = nlohmann::json::parse(read_file(path));
+        return vae_source_of(nlohmann::json::parse(read_file(path)));
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(path + ": malformed: " + e.what());
     }
+}
+
+VaeSource vae_source_of(const nlohmann::json& m) {
     VaeSource s;
     s.dir = m.value("vae_dir", default_vae_dir(""));
     if (m.contains("vae_torchscript")) {

@@ -3,6 +3,7 @@
 // dropout masks are functions of (seed, iteration), so a resumed run repeats the same iterations
 // as an uninterrupted one.
 #include "autodiff/lr_schedule.h"
+#include "core/sampler.h"
 #include "refiner/refiner_net.h"
 #include "vae/lpips_torch.h"
 #include "vae/ssim.h"
@@ -17,12 +18,8 @@ namespace lpt {
 
 namespace {
 
-uint64_t mix(uint64_t x) {  // splitmix64 finaliser
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-}
+/// splitmix64: the golden-ratio step, then the shared finaliser (core/sampler.h).
+uint64_t mix(uint64_t x) { return mix64(x + 0x9e3779b97f4a7c15ull); }
 
 int pick(uint64_t key, int range) { return range <= 0 ? 0 : int(mix(key) % uint64_t(range + 1)); }
 

@@ -107,7 +107,9 @@ TEST(EnvMap, ConstantMapEqualsConstantEmitter) {
         EXPECT_NEAR(mean_channel(b, 1), mean_channel(a, 1), 0.01 * mean_channel(a, 1)) << int(s);
         for (size_t i = 0; i < a.size(); i += 3) {
             const bool sky = a[i] > 0.79f && a[i] < 0.81f;
-            if (sky) EXPECT_NEAR(b[i], 0.8f, 1e-5f);  // escaped camera rays see the map exactly
+            if (sky) {
+                EXPECT_NEAR(b[i], 0.8f, 1e-5f);  // escaped camera rays see the map exactly
+            }
         }
     }
 }
