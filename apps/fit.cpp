@@ -68,6 +68,7 @@ int run_fit(const FitArgs& a) {
     o.min_delta = a.min_delta;
     o.tone = parse_tone_curve(a.tone);
     o.checkpoint_every = a.checkpoint_every;
+    o.reuse_paths = a.reuse_paths;
     o.checkpoint_dir = (fs::path(a.out) / "checkpoint").string();
 
     int w = 0, h = 0;

@@ -76,6 +76,11 @@ int main(int argc, char** argv) {
     fit->add_option("--gate", f.gate, "Ic gate: shadowed (1 - V) or visible (V)")->check(CLI::IsMember({"shadowed", "visible"}))->capture_default_str();
     fit->add_option("--terms", f.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
     fit->add_option("--checkpoint-every", f.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();
+    fit->add_option("--reuse-paths", f.reuse_paths,
+                    "0: fresh paths each iteration, re-traced for the gradient; K: trace and store paths every K iterations and replay them in between "
+                    "(no rays; ~56 bytes per path event of memory)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     fit->add_flag("--resume", f.resume, "continue from <out>/checkpoint");
     fit->add_flag("--encode", f.encode, "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
     fit->add_option("--encode-res", f.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")->capture_default_str();

@@ -1,6 +1,7 @@
 #include "autodiff/fit.h"
 #include "autodiff/latent_path_adjoint.h"
 #include "autodiff/loss.h"
+#include "autodiff/path_record.h"
 #include "autodiff/lr_schedule.h"
 #include "core/image_io.h"
 #include "core/sampler.h"
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -50,19 +52,28 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
     if (state.best_raw.empty()) state.best_raw = ps.raw();
 
     std::vector<float> d_toned(n), d_image(n);
+    // Stored paths serve K iterations; a checkpoint falls on a block boundary so that a resumed
+    // fit records the same paths from the same parameters as an uninterrupted one.
+    const int K = std::max(0, o.reuse_paths);
+    const int checkpoint_every = K > 0 && o.checkpoint_every > 0 ? (o.checkpoint_every + K - 1) / K * K : o.checkpoint_every;
+    std::optional<PathRecords> records;
     auto t0 = std::chrono::steady_clock::now();
     double seconds_before = state.history.empty() ? 0.0 : state.history.back().seconds;
     for (int it = state.next_iteration; it < o.iterations; ++it) {
-        RenderOptions ro = iteration_options(model, o, width, height, it);
+        const RenderOptions ro = iteration_options(model, o, width, height, K > 0 ? it - it % K : it);
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
-        std::vector<float> linear = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro).sum();
+        std::vector<float> linear;
+        if (K == 0) linear = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro).sum();
+        else if (it % K == 0 || !records) records = record_latent_paths(model, ro, &linear);
+        else linear = replay_forward(model, *records);
         std::vector<float> toned(n);
         tone_map(o.tone, linear.data(), toned.data(), n);
         double loss = huber_loss(toned.data(), target.data(), n, o.huber_delta, d_toned.data());
         tone_map_backward(o.tone, linear.data(), d_toned.data(), d_image.data(), n);
-        // Adjoint: path replay with the same options (same random numbers).
+        // Adjoint: path replay with the same options (same random numbers), or of the stored paths.
         ps.zero_grad();
-        backward_latent(model, ro, d_image);
+        if (K == 0) backward_latent(model, ro, d_image);
+        else replay_backward(model, *records, d_image);
         ps.backward();
         const float lr = schedule.lr_at(it);
         size_t bad = adam.step(ps.raw().data(), ps.grad_raw().data(), ps.raw().size(), lr);
@@ -81,7 +92,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         double secs = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         FitRecord rec{it, loss, state.smoothed, lr, secs, bad != 0};
         state.history.push_back(rec);
-        if (o.checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % o.checkpoint_every == 0) save_checkpoint(o.checkpoint_dir, model, state);
+        if (checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % checkpoint_every == 0) save_checkpoint(o.checkpoint_dir, model, state);
         if (on_iteration && !on_iteration(rec, state)) break;
         if (stop) break;
     }

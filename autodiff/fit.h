@@ -23,7 +23,12 @@ struct FitOptions {
     int patience = 300;           ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
     float smoothing = 0.95f;      ///< exponential moving average of the noisy per-iteration loss
-    int checkpoint_every = 100;   ///< 0 = never
+    /// 0: fresh paths every iteration, re-traced by the adjoint (path replay, memory of one
+    /// wavefront). K >= 1: trace and store one frame's paths every K iterations and replay the
+    /// stored paths (forward and adjoint) in between: no rays traced, memory ~56 B per event
+    /// (docs/path-replay.md (6), measured in docs/performance.md).
+    int reuse_paths = 0;
+    int checkpoint_every = 100;   ///< 0 = never; rounded up to a multiple of reuse_paths
     std::string checkpoint_dir;   ///< empty = no checkpoints
 };
 

@@ -44,4 +44,14 @@ struct SampleStream {
     float get(uint32_t dimension) const { return sample_from_key(key, dimension); }
 };
 
+/// The BSDF sample's random numbers at a depth: lobe choice and direction. Shared by the tracer
+/// and by path replay, which re-samples delta lobes (autodiff/path_record.cpp).
+struct BsdfRandoms {
+    float lobe;
+    float dir[2];
+};
+inline BsdfRandoms bsdf_randoms(const SampleStream& rng, uint32_t depth) {
+    return {rng.get(dim::bounce(depth, dim::kBsdfLobe)), {rng.get(dim::bounce(depth, dim::kBsdfDir)), rng.get(dim::bounce(depth, dim::kBsdfDir + 1))}};
+}
+
 }  // namespace lpt

@@ -67,7 +67,7 @@ public:
             st.extension_rays += ws.rays[1 - cur].size;
             cur = 1 - cur;
         }
-        if (m_obs) m_obs->end(ws.paths.pixel.data(), n);
+        if (m_obs) m_obs->end(ws.paths.pixel.data(), ws.paths.sample.data(), n);
         for (size_t k = 0; k < n; ++k) {
             films[0]->add_sample(int(ws.paths.pixel[k]), ws.paths.radiance[k]);
             if (m_terms) {
@@ -281,8 +281,8 @@ private:
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
             BSDFContext ctx;
             ctx.uv = sq.uv[k];
-            BSDFSample<N> bs = bsdf.sample(ctx, sq.wi[k], rng.get(dim::bounce(depth, dim::kBsdfLobe)),
-                                           Vec2f(rng.get(dim::bounce(depth, dim::kBsdfDir)), rng.get(dim::bounce(depth, dim::kBsdfDir + 1))));
+            const BsdfRandoms u = bsdf_randoms(rng, uint32_t(depth));
+            BSDFSample<N> bs = bsdf.sample(ctx, sq.wi[k], u.lobe, Vec2f(u.dir[0], u.dir[1]));
             if (!bs.valid()) continue;
             Spectrum<N> beta = p.beta[slot] * bs.weight;
             // |throughput|: sign-safe for latent spectra.
@@ -294,7 +294,7 @@ private:
             }
             // A zero throughput contributes nothing but may still have a derivative.
             if (!(beta != 0.f).any() && !m_obs) continue;
-            if (m_obs) m_obs->bounce(slot, sq.shape[k], p.beta[slot], ctx, sq.wi[k], bs, q);
+            if (m_obs) m_obs->bounce(slot, sq.shape[k], p.beta[slot], ctx, sq.wi[k], bs, q, depth);
             const Vec3f wo_world = sq.frame[k].to_world(bs.wo);
             p.beta[slot] = beta;
             p.prev_pdf[slot] = bs.pdf;
@@ -361,6 +361,12 @@ void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const Late
     total.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats) *stats = total;
 }
+
+}  // namespace
+
+int render_tile_count(int width, int height) { return ((width + kTile - 1) / kTile) * ((height + kTile - 1) / kTile); }
+
+namespace {
 
 Camera render_camera(const Scene& scene, const RenderOptions& opt) {
     return scene.camera.with_resolution(opt.width > 0 ? opt.width : scene.camera.width, opt.height > 0 ? opt.height : scene.camera.height);

@@ -63,6 +63,9 @@ template <int N>
 TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
                                  const RenderOptions& options, RenderStats* stats = nullptr, PathObserver<N>* observer = nullptr);
 
+/// Image tiles of a render at this resolution (observers index per-tile buffers by tile).
+int render_tile_count(int width, int height);
+
 /// Power heuristic (beta = 2) of sampling technique a against b (both as solid-angle pdfs).
 inline float mis_power(float pdf_a, float pdf_b) {
     float a2 = pdf_a * pdf_a, b2 = pdf_b * pdf_b;

@@ -1,7 +1,6 @@
 // PathObserver: sees every scoring event of every path while the wavefront tracer runs. The
-// path-replay adjoint (autodiff/latent_path_adjoint.cpp) is one: it re-traces the primal's paths
-// with the same random numbers and records what each vertex contributed, then sweeps each path
-// backwards (docs/path-replay.md). Hooks of one wavefront are called by one thread, in path order
+// path recorder (autodiff/path_record.h) is one: it keeps what does not depend on the learned
+// coefficients, and the adjoint sweeps those records backwards (docs/path-replay.md). Hooks of one wavefront are called by one thread, in path order
 // per slot: begin, then per depth [emission | ambient]* light_sample* bounce*, shadow*, then end.
 #pragma once
 #include "core/bsdf.h"
@@ -29,11 +28,12 @@ public:
                               const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, const Spectrum<N>& f, bool nee, bool first) = 0;
     /// The shadow ray `shadow_id` of the current depth was blocked or not.
     virtual void shadow(int shadow_id, bool blocked) = 0;
-    /// BSDF sampling continued the path from a vertex of `shape`: next beta = beta · bs.weight / q.
+    /// BSDF sampling at path depth `depth` continued the path from a vertex of `shape`:
+    /// next beta = beta · bs.weight / q.
     virtual void bounce(uint32_t slot, int shape, const Spectrum<N>& beta, const BSDFContext& ctx, const Vec3f& wi,
-                        const BSDFSample<N>& bs, float q) = 0;
-    /// The wavefront is done; pixel[slot] is each path's pixel.
-    virtual void end(const uint32_t* pixel, size_t n) = 0;
+                        const BSDFSample<N>& bs, float q, int depth) = 0;
+    /// The wavefront is done; path `slot` was sample sample[slot] of pixel pixel[slot].
+    virtual void end(const uint32_t* pixel, const uint32_t* sample, size_t n) = 0;
 };
 
 }  // namespace lpt

@@ -51,24 +51,29 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
         auto img = render_toned(truth, target_options(target_scene, 4, 1000 + s), ToneCurve::Clip);
         floor += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
     }
-    auto run = [&](bool extra_terms) {
+    auto run = [&](bool extra_terms, int reuse_paths) {
         Scene scene = cornell();
         LatentModel m(scene, Parameterisation::Code, 2);
         m.terms().ambient = m.terms().occlusion = extra_terms;
         double initial = huber_loss(render_toned(m, target_options(scene, 4, 5), ToneCurve::Clip).data(), target.data(), target.size(), 1.f, nullptr);
-        FitState st = fit_latent(m, target, kRes, kRes, fit_options(400));
+        FitOptions fo = fit_options(400);
+        fo.reuse_paths = reuse_paths;
+        FitState st = fit_latent(m, target, kRes, kRes, fo);
         double final_loss = 0;
         for (uint64_t s = 0; s < 8; ++s) {
             auto img = render_toned(m, target_options(scene, 4, 2000 + s), ToneCurve::Clip);
             final_loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
         }
-        std::cout << (extra_terms ? "Ie+Ia+Ic" : "Ie only") << ": initial " << initial << ", final " << final_loss << ", noise floor " << floor
+        std::cout << (extra_terms ? "Ie+Ia+Ic" : "Ie only") << " (reuse " << reuse_paths << "): initial " << initial << ", final " << final_loss << ", noise floor " << floor
                   << ", skipped steps " << st.skipped_steps << "\n";
         EXPECT_EQ(st.skipped_steps, 0);
         return std::pair{initial, final_loss};
     };
-    auto [init_full, final_full] = run(true);
-    auto [init_e, final_e] = run(false);
+    auto [init_full, final_full] = run(true, 0);
+    auto [init_e, final_e] = run(false, 0);
+    // Stored paths replayed for 4 iterations at a time: the same bound (docs/path-replay.md (6)).
+    auto [init_reuse, final_reuse] = run(true, 4);
+    EXPECT_LT(final_reuse, 3.0 * floor);
     // Recovered: within 3x of the noise floor of a perfect fit (the fit itself is a noisy
     // estimate from 4-spp gradients), and far below where it started.
     EXPECT_LT(final_full, 3.0 * floor);
@@ -77,19 +82,24 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
     EXPECT_LE(final_full, 1.05 * final_e);
 }
 
-TEST(Fit, ResumedFitEndsBitIdentical) {
+namespace {
+
+/// Fits 30 iterations whole, and again "killed" after iteration 16 with checkpoints every 10
+/// (with stored paths: rounded up to a multiple of K), then resumed from the checkpoint.
+void expect_resume_bit_identical(int reuse_paths, int expected_next) {
     namespace fs = std::filesystem;
     Scene ts = cornell();
     LatentModel truth(ts, Parameterisation::Paper, 1);
     const std::vector<float> target = render_toned(truth, target_options(ts, 16, 7), ToneCurve::Clip);
     const std::string dir = test::write_temp_file("resume/placeholder", "");
-    const std::string ckpt = fs::path(dir).parent_path().string() + "/ckpt";
+    const std::string ckpt = fs::path(dir).parent_path().string() + "/ckpt" + std::to_string(reuse_paths);
     fs::remove_all(ckpt);
 
     Scene s1 = cornell();
     LatentModel full(s1, Parameterisation::Paper, 2);
     FitOptions o = fit_options(30);
     o.patience = 5;  // early-stopping state must survive the restart too
+    o.reuse_paths = reuse_paths;
     FitState whole = fit_latent(full, target, kRes, kRes, o);
 
     Scene s2 = cornell();
@@ -97,17 +107,22 @@ TEST(Fit, ResumedFitEndsBitIdentical) {
     FitOptions killed = o;
     killed.checkpoint_every = 10;
     killed.checkpoint_dir = ckpt;
-    // "Killed" after iteration 16: the last checkpoint holds iterations 0-9 (next_iteration 10).
     fit_latent(part, target, kRes, kRes, killed, {}, [](const FitRecord& r, const FitState&) { return r.iteration < 16; });
     Scene s3 = cornell();
     LatentModel resumed(s3, Parameterisation::Paper, 99);  // different init: the checkpoint must overwrite it
     FitState st = load_checkpoint(ckpt, resumed);
-    EXPECT_EQ(st.next_iteration, 10);
+    EXPECT_EQ(st.next_iteration, expected_next);
     FitState rest = fit_latent(resumed, target, kRes, kRes, o, st);
     EXPECT_EQ(rest.history.size(), whole.history.size());
     EXPECT_EQ(rest.history.back().loss, whole.history.back().loss);
     EXPECT_EQ(resumed.params().raw(), full.params().raw());
 }
+
+}  // namespace
+
+TEST(Fit, ResumedFitEndsBitIdentical) { expect_resume_bit_identical(0, 10); }
+
+TEST(Fit, ResumedFitWithStoredPathsEndsBitIdentical) { expect_resume_bit_identical(4, 12); }
 
 TEST(Fit, RejectsNonFiniteOrMisshapenTargets) {
     Scene s = cornell();
