@@ -1,4 +1,5 @@
 #include "test_util.h"
+#include "core/sampler.h"
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -22,6 +23,12 @@ std::string shared_dir() {
         if (fs::is_directory(env)) return env;
     }
     return fs::is_directory(LPT_SHARED_DIR) ? std::string(LPT_SHARED_DIR) : std::string();
+}
+
+std::vector<float> random_weights(size_t n, uint64_t seed) {
+    std::vector<float> w(n);
+    for (size_t i = 0; i < n; ++i) w[i] = 2.f * sample_1d(seed, uint32_t(i), 0, 0) - 1.f;
+    return w;
 }
 
 }  // namespace lpt::test

@@ -1,6 +1,8 @@
 // Shared test helpers: temp files, the ../shared data folder, statistics.
 #pragma once
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace lpt::test {
 
@@ -8,5 +10,7 @@ namespace lpt::test {
 std::string write_temp_file(const std::string& name, const std::string& contents);
 /// ../shared (LATENTPT_SHARED env var overrides); empty string if it does not exist.
 std::string shared_dir();
+/// n deterministic weights uniform in [-1, 1): a loss Σ W · Ĩ whose gradient d_image is W.
+std::vector<float> random_weights(size_t n, uint64_t seed);
 
 }  // namespace lpt::test

@@ -30,11 +30,7 @@ RenderOptions opts(const Scene& s) {
     return o;
 }
 
-std::vector<float> weights(size_t n) {
-    std::vector<float> w(n);
-    for (size_t i = 0; i < n; ++i) w[i] = 2.f * sample_1d(77, uint32_t(i), 0, 0) - 1.f;
-    return w;
-}
+std::vector<float> weights(size_t n) { return test::random_weights(n, 77); }
 
 double loss(LatentModel& m, const RenderOptions& o, const std::vector<float>& w) {
     m.sync();

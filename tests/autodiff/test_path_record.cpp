@@ -7,6 +7,7 @@
 #include "autodiff/path_record.h"
 #include "core/sampler.h"
 #include "core/scene_loader.h"
+#include "test_util.h"
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 #include <cmath>
@@ -47,11 +48,7 @@ RenderOptions opts(const Scene& s) {
     return o;
 }
 
-std::vector<float> weights(size_t n) {
-    std::vector<float> w(n);
-    for (size_t i = 0; i < n; ++i) w[i] = 2.f * sample_1d(5, uint32_t(i), 0, 0) - 1.f;
-    return w;
-}
+std::vector<float> weights(size_t n) { return test::random_weights(n, 5); }
 
 double max_rel_diff(const std::vector<float>& a, const std::vector<float>& b) {
     double scale = 0, diff = 0;
