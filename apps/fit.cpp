@@ -139,6 +139,7 @@ int run_fit(const FitArgs& a) {
     std::vector<float> linear = films.sum(), toned(linear.size()), diff(linear.size());
     tone_map(o.tone, linear.data(), toned.data(), linear.size());
     for (size_t i = 0; i < toned.size(); ++i) diff[i] = toned[i] - target[i];
+    const double final_loss = huber_loss(toned.data(), target.data(), toned.size(), 1.f, nullptr);
     const fs::path out(a.out);
     write_text_atomic((out / "params.json").string(), model.params().to_json());
     // Everything `latentpt render <fitdir> --edit` needs to rebuild this model.
@@ -148,6 +149,10 @@ int run_fit(const FitArgs& a) {
     if (a.vae.torchscript())
         manifest["vae_torchscript"] = {{"encoder", fs::absolute(a.vae.encoder).string()}, {"decoder", fs::absolute(a.vae.decoder).string()},
                                        {"config", fs::absolute(a.vae.config).string()}};
+    // How stage 1 went, for comparing runs (e.g. --reuse-paths) without parsing logs.
+    manifest["stage1"] = {{"final_loss", final_loss}, {"final_spp", a.final_spp}, {"iterations_run", state.next_iteration},
+                          {"best_iteration", state.best_iteration}, {"seconds", state.history.empty() ? 0.0 : state.history.back().seconds},
+                          {"spp", a.spp}, {"reuse_paths", a.reuse_paths}, {"skipped_steps", state.skipped_steps}};
     write_text_atomic((out / "fit.json").string(), manifest.dump(2));
     write_latent((out / "latent.exr").string(), w, h, toned);
     // AOVs of the same view with the same samples: what the refiner reads beside the latent.
@@ -161,7 +166,6 @@ int run_fit(const FitArgs& a) {
     write_png_srgb((out / "target.png").string(), latent_grid(target.data(), w, h, kLatentChannels, scale));
     write_png_srgb((out / "render.png").string(), latent_grid(toned.data(), w, h, kLatentChannels, scale));
     write_png_srgb((out / "diff.png").string(), latent_grid(diff.data(), w, h, kLatentChannels, scale));
-    double final_loss = huber_loss(toned.data(), target.data(), toned.size(), 1.f, nullptr);
     if (a.encode) {
         // What a person looks at: the fitted latent decoded to RGB next to the reference.
         VaeArgs d{(out / "latent.exr").string(), (out / "decoded.png").string(), a.vae, true};

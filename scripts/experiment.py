@@ -155,6 +155,8 @@ def main():
         sdir = os.path.join(a.out, scene)
         os.makedirs(sdir, exist_ok=True)
         times = {}
+        stage_t0 = scene_t0 = time.time()
+        stages = {}  # wall seconds per stage of this run (reused results cost ~0)
         for name, (terms, extra, refine, lr) in FITS.items():
             fit_dir = os.path.join(sdir, "fit_" + name)
             cmd = [a.bin, "fit", scene_file, "--encode", "--encode-res", f"{image_res}x{image_res}", "--ref-spp", str(ref_spp),
@@ -171,7 +173,9 @@ def main():
             times["fit_" + name] = run(cmd, log)
         with open(os.path.join(sdir, "fit_eac", "metrics.json")) as f:
             train = json.load(f)
-        summary[scene] = {"training_view": train, "seconds": times, "edits": {}}
+        stages["fits"] = time.time() - stage_t0
+        stage_t0 = time.time()
+        summary[scene] = {"training_view": train, "seconds": times, "stages": stages, "edits": {}}
         r_l, f_l = train["rendered"].get("rgb_lpips"), train["refined"].get("rgb_lpips")
         if r_l is not None and f_l is not None and f_l > r_l * 1.0001:
             failures.append(f"{scene}: refiner worse than the rendered latent on the training view (LPIPS {f_l:.4f} > {r_l:.4f})")
@@ -207,6 +211,8 @@ def main():
                 if table[key]["rgb_lpips"] > base * 1.05:
                     failures.append(f"{scene}/{kind}: {key} LPIPS {table[key]['rgb_lpips']:.4f} worse than e alone {base:.4f}")
 
+        stages["edits (references + renders)"] = time.time() - stage_t0
+        stage_t0 = time.time()
         # Convergence: latent D-SSIM and decoded LPIPS of the eac fit (rendered and refined) vs
         # spp, on the training view and on the camera edit's last keyframe (a novel view).
         with open(os.path.join(ROOT, "scenes", scene, "edits-camera.json")) as f:
@@ -231,12 +237,16 @@ def main():
                 r = read_metrics(os.path.join(out, "metrics.csv"))[0]
                 conv[view][spp] = {k: float(r[k] or "nan") for k in ("latent_dssim", "rgb_lpips", "refined_latent_dssim", "refined_rgb_lpips")}
         summary[scene]["convergence"] = conv
+        stages["convergence"] = time.time() - stage_t0
+        stage_t0 = time.time()
         # Equal-error runtime: latent renderer vs RGB path tracing (+ VAE), timed in one process.
         print(f"[{scene}] equal-error runtime ...", flush=True)
         r = subprocess.run([a.bin, "bench", "--equal-error", os.path.join(sdir, "fit_eac")], capture_output=True, text=True)
         if r.returncode != 0:
             sys.exit(f"experiment: bench --equal-error failed: {r.stderr}")
         summary[scene]["equal_error"] = r.stdout
+        stages["equal-error benchmark"] = time.time() - stage_t0
+        summary[scene]["wall_seconds"] = time.time() - scene_t0
 
     # Tables (markdown) and plots.
     colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
@@ -270,6 +280,9 @@ def main():
                                  ("rgb_lpips", "LPIPS", "#ff7f0e"), ("refined_rgb_lpips", "LPIPS refined", "#d62728"))], "error")
                 with open(os.path.join(a.out, f"{scene}_convergence_{view}.svg"), "w") as f:
                     f.write(svg)
+        if "wall_seconds" in s:
+            md += ["", f"Wall time of this run for {scene}: {s['wall_seconds'] / 60:.1f} min (budget 120 min; " +
+                   ", ".join(f"{k} {v / 60:.1f}" for k, v in s["stages"].items()) + " min; finished results reused count ~0)"]
         if "equal_error" in s:
             md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
                    s["equal_error"].rstrip(), "```"]
