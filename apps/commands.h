@@ -93,7 +93,7 @@ struct FitArgs {
     int iterations = 3000, spp = 16, final_spp = 256;
     uint64_t seed = 0;
     float lr = 1e-3f, lr_min = 0.f, min_delta = 1e-5f;
-    int lr_period = 500, patience = 300, checkpoint_every = 100, reuse_paths = 0;
+    int lr_period = 500, patience = 300, checkpoint_every = 100, reuse_paths = 8;
     std::string tone = "clip", param = "code", gate = "shadowed", terms = "eac";
     bool resume = false, quiet = false;
     std::map<std::string, std::string> defines;
