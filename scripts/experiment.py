@@ -41,10 +41,13 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 
 # name -> (scene file under <shared>/scenes, -D overrides)
+# scene: (file under ../shared/scenes, -D defines, default reference spp). The reference traces
+# dominate the budget (docs/results.md "Budget"): at 256² a 512-spp cbox frame took 22 s on the
+# 2-core machine, 180 frames 66 min; dining-room frames cost ~2x cbox's, veach-bidir ~1.2x.
 SCENES = {
-    "cbox-specular": ("cbox/cbox_specular.xml", []),
-    "veach-bidir": ("veach-bidir/scene_v3.xml", []),
-    "dining-room": ("dining-room/scene_diffuse.xml", []),
+    "cbox-specular": ("cbox/cbox_specular.xml", [], 256),
+    "veach-bidir": ("veach-bidir/scene_v3.xml", [], 256),
+    "dining-room": ("dining-room/scene_diffuse.xml", [], 128),
 }
 KINDS = ["camera", "light", "object"]
 CONFIGS = [("e", "Ĩe"), ("ea", "+Ĩa"), ("eac", "+Ĩc"), ("eac+refiner", "+refiner"),
@@ -123,7 +126,7 @@ def main():
     ap.add_argument("--shared", default=os.environ.get("LATENTPT_SHARED", os.path.join(ROOT, "..", "shared")))
     ap.add_argument("--image-res", type=int, default=None, help="square RGB resolution (latents: 1/8)")
     ap.add_argument("--frames", type=int, default=None, help="frames per edit sequence (default: the files', 60)")
-    ap.add_argument("--ref-spp", type=int, default=None, help="samples per pixel of the RGB references")
+    ap.add_argument("--ref-spp", type=int, default=None, help="samples per pixel of the RGB references (default: per scene, 128-256)")
     ap.add_argument("--fit-iterations", type=int, default=None)
     ap.add_argument("--refiner-iterations", type=int, default=None)
     ap.add_argument("--spp", type=int, default=64, help="latent samples per pixel of the edited frames")
@@ -131,7 +134,6 @@ def main():
     a = ap.parse_args()
     q = a.quick
     image_res = a.image_res or (128 if q else 256)
-    ref_spp = a.ref_spp or (32 if q else 512)
     fit_its = a.fit_iterations or (300 if q else 1500)
     ref_its = a.refiner_iterations or (100 if q else 1000)
     frames = a.frames or (3 if q else None)
@@ -147,7 +149,8 @@ def main():
     summary = {}
     failures = []
     for scene in scenes:
-        rel, defines = SCENES[scene]
+        rel, defines, scene_ref_spp = SCENES[scene]
+        ref_spp = a.ref_spp or (32 if q else scene_ref_spp)
         scene_file = os.path.join(a.shared, "scenes", rel)
         if not os.path.exists(scene_file):
             print(f"experiment: {scene_file} not found (set LATENTPT_SHARED or --shared)", file=sys.stderr)
@@ -175,7 +178,7 @@ def main():
             train = json.load(f)
         stages["fits"] = time.time() - stage_t0
         stage_t0 = time.time()
-        summary[scene] = {"training_view": train, "seconds": times, "stages": stages, "edits": {}}
+        summary[scene] = {"training_view": train, "seconds": times, "stages": stages, "ref_spp": ref_spp, "edits": {}}
         r_l, f_l = train["rendered"].get("rgb_lpips"), train["refined"].get("rgb_lpips")
         if r_l is not None and f_l is not None and f_l > r_l * 1.0001:
             failures.append(f"{scene}: refiner worse than the rendered latent on the training view (LPIPS {f_l:.4f} > {r_l:.4f})")
@@ -252,11 +255,11 @@ def main():
     colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
                "baseline+refiner": "#e377c2"}
     md = ["# latentpt experiment summary", "",
-          f"settings: image {image_res}² (latents {image_res // 8}²), reference {ref_spp} spp, stage 1 {fit_its} iterations, "
+          f"settings: image {image_res}² (latents {image_res // 8}²), reference spp per scene below, stage 1 {fit_its} iterations, "
           f"refiner {ref_its} iterations, frames {frames or 'as in the edit files'}, edited latents {a.spp} spp", ""]
     for scene, s in summary.items():
         t = s["training_view"]
-        md += [f"## {scene}", "", "Training view (decoded vs reference): " +
+        md += [f"## {scene}", "", f"References: {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
                ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
                          for k in ("rendered", "refined", "vae_roundtrip") if k in t), "",
                "| edit | config | LPIPS | MSE×100 | latent D-SSIM |", "|---|---|---|---|---|"]
