@@ -64,7 +64,10 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
         std::vector<float> linear;
         if (K == 0) linear = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro).sum();
-        else if (it % K == 0 || !records) records = record_latent_paths(model, ro, &linear);
+        else if (it % K == 0 || !records) {
+            records.reset();  // free the previous frame first: peak memory stays one frame
+            records = record_latent_paths(model, ro, &linear);
+        }
         else linear = replay_forward(model, *records);
         std::vector<float> toned(n);
         tone_map(o.tone, linear.data(), toned.data(), n);
