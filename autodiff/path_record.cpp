@@ -49,7 +49,7 @@ void PathRecorder::begin(int tile, size_t n) {
     for (size_t i = 0; i < n; ++i) s.paths[i].clear();
 }
 
-void PathRecorder::emission(uint32_t slot, int emitter, const L&, float mis) {
+void PathRecorder::emission(uint32_t slot, int emitter, float mis) {
     PathEvent e;
     e.type = PathEvent::Emission;
     e.emitter = emitter;
@@ -57,15 +57,15 @@ void PathRecorder::emission(uint32_t slot, int emitter, const L&, float mis) {
     Threads::current->paths[slot].push_back(e);
 }
 
-void PathRecorder::ambient(uint32_t slot, int shape, const L&) {
+void PathRecorder::ambient(uint32_t slot, int shape) {
     PathEvent e;
     e.type = PathEvent::Ambient;
     e.shape = shape;
     Threads::current->paths[slot].push_back(e);
 }
 
-void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emitter, const L&, float w_over_pdf, const BSDFContext& ctx,
-                                const Vec3f& wi, const Vec3f& wo, const L&, bool nee, bool first) {
+void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emitter, float w_over_pdf, const BSDFContext& ctx,
+                                const Vec3f& wi, const Vec3f& wo, bool nee, bool first) {
     PathEvent e;
     e.type = PathEvent::Light;
     e.shape = shape;
@@ -89,7 +89,7 @@ void PathRecorder::shadow(int shadow_id, bool blocked) {
     if (!blocked) s.paths[slot][idx].flags |= PathEvent::kVisible;
 }
 
-void PathRecorder::bounce(uint32_t slot, int shape, const L&, const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<kLatentChannels>& bs,
+void PathRecorder::bounce(uint32_t slot, int shape, const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<kLatentChannels>& bs,
                           float q, int depth) {
     PathEvent e;
     e.type = PathEvent::Bounce;

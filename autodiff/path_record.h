@@ -68,12 +68,12 @@ public:
     explicit PathRecorder(int n_tiles);
     ~PathRecorder() override;
     void begin(int tile, size_t n) override;
-    void emission(uint32_t slot, int emitter, const Latent& beta, float mis) override;
-    void ambient(uint32_t slot, int shape, const Latent& beta) override;
-    void light_sample(uint32_t slot, int shadow_id, int shape, int emitter, const Latent& beta, float w_over_pdf, const BSDFContext& ctx,
-                      const Vec3f& wi, const Vec3f& wo, const Latent& f, bool nee, bool first) override;
+    void emission(uint32_t slot, int emitter, float mis) override;
+    void ambient(uint32_t slot, int shape) override;
+    void light_sample(uint32_t slot, int shadow_id, int shape, int emitter, float w_over_pdf, const BSDFContext& ctx,
+                      const Vec3f& wi, const Vec3f& wo, bool nee, bool first) override;
     void shadow(int shadow_id, bool blocked) override;
-    void bounce(uint32_t slot, int shape, const Latent& beta, const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<kLatentChannels>& bs,
+    void bounce(uint32_t slot, int shape, const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<kLatentChannels>& bs,
                 float q, int depth) override;
     void end(const uint32_t* pixel, const uint32_t* sample, size_t n) override;
     std::vector<std::vector<PathBlock>>& records() { return m_records; }

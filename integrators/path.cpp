@@ -144,7 +144,7 @@ private:
             if (!rays.hit(i)) {
                 if (m_terms && m_terms->ambient && !p.past_first[slot]) {
                     p.ambient[slot] += p.beta[slot] * m_terms->background;
-                    if (m_obs) m_obs->ambient(slot, -1, p.beta[slot]);
+                    if (m_obs) m_obs->ambient(slot, -1);
                 }
                 if (env < 0 || !m_emission) continue;
                 const Vec3f dir = rays.direction(i);
@@ -155,7 +155,7 @@ private:
                     float factor;
                     const Spectrum<N> le = emitted(env, dir, &factor);
                     p.radiance[slot] += p.beta[slot] * (w * le);
-                    if (m_obs) m_obs->emission(slot, env, p.beta[slot], w * factor);
+                    if (m_obs) m_obs->emission(slot, env, w * factor);
                 }
                 continue;
             }
@@ -170,7 +170,7 @@ private:
                     float w = hit_weight(p, slot, light_pdf);
                     if (w > 0.f) {
                         p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
-                        if (m_obs) m_obs->emission(slot, shape.emitter, p.beta[slot], w);
+                        if (m_obs) m_obs->emission(slot, shape.emitter, w);
                     }
                 }
             }
@@ -181,7 +181,7 @@ private:
                 p.past_first[slot] = 1;
                 if (m_terms->ambient) {
                     p.ambient[slot] += p.beta[slot] * m_terms->La[shape_id];
-                    if (m_obs) m_obs->ambient(slot, shape_id, p.beta[slot]);
+                    if (m_obs) m_obs->ambient(slot, shape_id);
                 }
             }
             // Without Ĩe nothing is collected after the first non-delta vertex.
@@ -216,7 +216,7 @@ private:
             const bool gate_shadowed = m_terms && m_terms->gate == OcclusionGate::Shadowed;
             if (m_scene.lights.empty()) {  // no light: everything is in shadow
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
-                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], Spectrum<N>::Zero(), false, true);
+                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
             SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
@@ -227,7 +227,7 @@ private:
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
             if (!ls.valid() || sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f) {
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
-                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, p.beta[slot], 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], Spectrum<N>::Zero(), false, true);
+                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
             Spectrum<N> contribution = Spectrum<N>::Zero();
@@ -235,10 +235,9 @@ private:
             ctx.uv = sq.uv[k];
             const Vec3f wo = sq.frame[k].to_local(ls.wi);
             float w_over_pdf = 0.f;
-            Spectrum<N> f = Spectrum<N>::Zero();
             if (nee) {
                 const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
-                f = bsdf.eval(ctx, sq.wi[k], wo);
+                const Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
                 // A zero f (a latent reflectance at 0) still has a derivative: keep it for the adjoint.
                 if ((f != 0.f).any() || m_obs) {
                     float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
@@ -262,7 +261,7 @@ private:
                 dir = d / dist;
                 tmax = dist * (1.f - 1e-4f);
             }
-            if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, p.beta[slot], w_over_pdf, ctx, sq.wi[k], wo, f, nee, first);
+            if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, w_over_pdf, ctx, sq.wi[k], wo, nee, first);
             ws.shadow.rays.push(o, dir, 0.f, tmax);
             ws.shadow.slot.push_back(slot);
             ws.shadow.contribution.push_back(contribution);
@@ -294,7 +293,7 @@ private:
             }
             // A zero throughput contributes nothing but may still have a derivative.
             if (!(beta != 0.f).any() && !m_obs) continue;
-            if (m_obs) m_obs->bounce(slot, sq.shape[k], p.beta[slot], ctx, sq.wi[k], bs, q, depth);
+            if (m_obs) m_obs->bounce(slot, sq.shape[k], ctx, sq.wi[k], bs, q, depth);
             const Vec3f wo_world = sq.frame[k].to_world(bs.wo);
             p.beta[slot] = beta;
             p.prev_pdf[slot] = bs.pdf;
