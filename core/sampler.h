@@ -41,7 +41,12 @@ inline float sample_1d(uint64_t seed, uint32_t pixel, uint32_t sample_index, uin
 struct SampleStream {
     uint64_t key;
     SampleStream(uint64_t seed, uint32_t pixel, uint32_t index) : key(sample_key(seed, pixel, index)) {}
+    /// From a key hashed earlier (the tracer keeps one per path instead of rehashing per stage).
+    static SampleStream from_key(uint64_t key) { return SampleStream(key); }
     float get(uint32_t dimension) const { return sample_from_key(key, dimension); }
+
+private:
+    explicit SampleStream(uint64_t k) : key(k) {}
 };
 
 /// The BSDF sample's random numbers at a depth: lobe choice and direction. Shared by the tracer

@@ -89,7 +89,8 @@ private:
             int x = x0 + local % w, y = y0 + local / w;
             p.pixel[k] = uint32_t(y * m_camera.width + x);
             p.sample[k] = uint32_t(s0 + int(k) % count);
-            SampleStream rng{m_opt.seed, p.pixel[k], p.sample[k]};
+            const SampleStream rng{m_opt.seed, p.pixel[k], p.sample[k]};
+            p.key[k] = rng.key;
             Vec2f offset = m_camera.filter.sample(Vec2f(rng.get(dim::kFilter), rng.get(dim::kFilter + 1)));
             Ray r = m_camera.generate_ray(Vec2f(x + 0.5f + offset.x(), y + 0.5f + offset.y()), tan_half);
             p.beta[k].setOnes();
@@ -219,7 +220,7 @@ private:
                 if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
-            SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
+            const SampleStream rng = SampleStream::from_key(p.key[slot]);
             LightSample ls = m_scene.lights.sample(m_scene.emitters, m_scene.shapes, sq.p[k], rng.get(dim::bounce(depth, dim::kLightChoice)),
                                                    Vec2f(rng.get(dim::bounce(depth, dim::kLightPos)), rng.get(dim::bounce(depth, dim::kLightPos + 1))));
             // A light sample behind the light or below the viewer's side of the surface is an
@@ -258,7 +259,7 @@ private:
             if (!m_scene.emitters[ls.emitter].is_environment()) {
                 Vec3f d = ls.p - o;
                 float dist = d.norm();
-                dir = d / dist;
+                dir = d * (1.f / dist);
                 tmax = dist * (1.f - 1e-4f);
             }
             if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, w_over_pdf, ctx, sq.wi[k], wo, nee, first);
@@ -277,7 +278,7 @@ private:
             if (!(sq.flags[k] & ShadeQueue::kContinue)) continue;
             const uint32_t slot = sq.slot[k];
             const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
-            SampleStream rng{m_opt.seed, p.pixel[slot], p.sample[slot]};
+            const SampleStream rng = SampleStream::from_key(p.key[slot]);
             BSDFContext ctx;
             ctx.uv = sq.uv[k];
             const BsdfRandoms u = bsdf_randoms(rng, uint32_t(depth));

@@ -41,7 +41,8 @@ template <int N>
 struct PathState {
     AlignedVector<Spectrum<N>> beta;       ///< throughput (signed for latents)
     AlignedVector<Spectrum<N>> radiance;   ///< accumulated estimate
-    std::vector<uint32_t> pixel, sample;   ///< film pixel and sample index (sampler key)
+    std::vector<uint32_t> pixel, sample;   ///< film pixel and sample index
+    std::vector<uint64_t> key;             ///< sample_key(seed, pixel, sample), hashed once
     std::vector<float> prev_pdf;           ///< solid-angle pdf of the last BSDF sample (MIS)
     std::vector<uint8_t> prev_delta;       ///< last scattering was a delta lobe (or camera)
     AlignedVector<Vec3f> prev_p;           ///< last vertex position (area-light pdf on hits)
@@ -49,7 +50,7 @@ struct PathState {
     std::vector<uint8_t> past_first;       ///< the first non-delta vertex is behind us (latent)
 
     void resize(size_t n) {
-        beta.resize(n); radiance.resize(n); pixel.resize(n); sample.resize(n);
+        beta.resize(n); radiance.resize(n); pixel.resize(n); sample.resize(n); key.resize(n);
         prev_pdf.resize(n); prev_delta.resize(n); prev_p.resize(n);
         ambient.resize(n); occlusion.resize(n); past_first.resize(n);
     }

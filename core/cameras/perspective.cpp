@@ -22,14 +22,15 @@ Vec2f Camera::tan_half_fov() const {
 Ray Camera::generate_ray(const Vec2f& film_pos, const Vec2f& th) const {
     float sx = film_pos.x() / float(width), sy = film_pos.y() / float(height);
     Vec3f d_cam((1.f - 2.f * sx) * th.x(), (1.f - 2.f * sy) * th.y(), 1.f);
-    float inv_len = 1.f / d_cam.norm();
     Ray r;
-    r.o = world_from_camera.point(Vec3f::Zero());
-    r.d = world_from_camera.vector(d_cam * inv_len).normalized();
-    // Clip planes are distances along the optical axis: convert to distances along this ray.
-    float cos_axis = inv_len;
-    r.tmin = near_clip / cos_axis;
-    r.tmax = far_clip / cos_axis;
+    r.o = world_from_camera.m.topRightCorner<3, 1>();
+    const Vec3f d = world_from_camera.vector(d_cam);  // to_world may scale: normalise after it
+    r.d = d * (1.f / d.norm());
+    // Clip planes are distances along the optical axis (z = 1 in d_cam): along this ray they
+    // are |d_cam| times longer.
+    const float len = d_cam.norm();
+    r.tmin = near_clip * len;
+    r.tmax = far_clip * len;
     return r;
 }
 

@@ -11,7 +11,7 @@ LightSample sample_area_light(const Shape& shape, const Vec3f& ref, const Eigen:
     float dist2 = d.squaredNorm();
     if (dist2 <= 0.f) return ls;
     ls.dist = std::sqrt(dist2);
-    ls.wi = d / ls.dist;
+    ls.wi = d * (1.f / ls.dist);
     ls.p = ps.p;
     ls.n = ps.n;
     float cos_l = -ls.wi.dot(ps.n);
