@@ -48,6 +48,27 @@ struct BSDFSample {
     bool valid() const { return pdf > 0.f; }
 };
 
+/// Whether a BSDF is the Lambertian reflector ("diffuse"), alone or inside "twosided". The
+/// tracer samples those from directions it warps for the whole shade queue at once
+/// (sample_cosine_hemisphere_batch) through lambertian_sample below, which is also
+/// Diffuse::sample itself, so the two cannot drift apart.
+enum class Lambertian : uint8_t { No, OneSided, TwoSided };
+
+/// Lambertian BSDF sample from a cosine-warped direction `wo` of the upper hemisphere: one-sided
+/// needs cos wi > 0; two-sided mirrors a lower-side wi and the result (as TwoSided does).
+/// Weight = reflectance exactly, (R/pi cos) / (cos/pi) (docs/bsdfs.md (13)).
+template <int N>
+BSDFSample<N> lambertian_sample(Lambertian sides, const Vec3f& wi, const Vec3f& wo, const Spectrum<N>& reflectance) {
+    const bool below = sides == Lambertian::TwoSided && cos_theta(wi) < 0.f;
+    BSDFSample<N> bs;
+    if ((below ? -cos_theta(wi) : cos_theta(wi)) <= 0.f || !(cos_theta(wo) > 0.f)) return bs;  // wo on the horizon: eval = 0
+    bs.wo = below ? Vec3f(wo.x(), wo.y(), -wo.z()) : wo;
+    bs.pdf = cos_theta(wo) * kInvPi;
+    bs.lobe = kDiffuseReflection;
+    bs.weight = reflectance;
+    return bs;
+}
+
 template <int N>
 class BSDF {
 public:
@@ -61,7 +82,10 @@ public:
     /// OR of the lobes this BSDF can produce.
     virtual uint32_t flags() const = 0;
     /// Hemispherical reflectance-like colour for the albedo AOV (not an integral; a display value).
+    /// For a Lambertian BSDF, its reflectance.
     virtual Spectrum<N> albedo(const BSDFContext& ctx) const = 0;
+    /// Lambertian::No unless sample() is lambertian_sample() of a cosine-warped direction.
+    virtual Lambertian lambertian() const { return Lambertian::No; }
 
     /// Spectral coefficients exposed to fitting, by scene-file key (e.g. "reflectance"); the
     /// latent renderer fills them from its ParamStore (docs/params.md).

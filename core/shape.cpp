@@ -32,20 +32,20 @@ void Shape::prepare() {
 }
 
 PositionSample Shape::sample_position(const Eigen::Vector3f& u) const {
-    size_t t = std::min<size_t>(std::upper_bound(m_cdf.begin(), m_cdf.end(), u.x()) - m_cdf.begin(), m_cdf.size() - 1);
+    const uint32_t t = pick_triangle(u.x());
     Vec2f b = sample_uniform_triangle(Vec2f(u.y(), u.z()));
     PositionSample ps;
     const uint32_t* idx = &mesh.indices[3 * t];
     const Vec3f &p0 = mesh.positions[idx[0]], &p1 = mesh.positions[idx[1]], &p2 = mesh.positions[idx[2]];
     ps.p = (1.f - b.x() - b.y()) * p0 + b.x() * p1 + b.y() * p2;
-    ps.n = emission_normal(uint32_t(t), b.x(), b.y());
+    ps.n = emission_normal(t, b.x(), b.y());
     ps.pdf_area = 1.f / m_area;
     return ps;
 }
 
 Vec3f Shape::emission_normal(uint32_t prim, float u, float v) const {
     const uint32_t* idx = &mesh.indices[3 * prim];
-    if (!face_normals && !mesh.normals.empty()) {
+    if (!flat()) {
         Vec3f n = (1.f - u - v) * mesh.normals[idx[0]] + u * mesh.normals[idx[1]] + v * mesh.normals[idx[2]];
         float len = n.norm();
         if (len > 0.f) return n / len;

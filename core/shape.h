@@ -4,6 +4,7 @@
 #pragma once
 #include "core/geometry.h"
 #include "core/mesh.h"
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,19 @@ public:
     float area() const { return m_area; }
     /// Uniform by area: u.x() picks the triangle (then is reused), u.y()/u.z() the point.
     PositionSample sample_position(const Eigen::Vector3f& u) const;
+    /// sample_position's triangle for u.x().
+    uint32_t pick_triangle(float u) const {
+        size_t t = 0;
+        if (m_cdf.size() <= 8) {  // typical emitters (a quad: two): a count, no mispredicted search steps
+            for (float c : m_cdf) t += size_t(c <= u);
+        } else {
+            t = size_t(std::upper_bound(m_cdf.begin(), m_cdf.end(), u) - m_cdf.begin());
+        }
+        return uint32_t(std::min(t, m_cdf.size() - 1));
+    }
+    /// Whether emission_normal is the face normal (no interpolated vertex normals).
+    bool flat() const { return face_normals || mesh.normals.empty(); }
+    const Vec3f& face_normal(uint32_t prim) const { return m_face_normals[prim]; }
     /// Hit record from Embree's (primID, u, v, t): barycentrics p = (1-u-v) p0 + u p1 + v p2.
     SurfaceInteraction interaction(uint32_t prim, float u, float v, float t) const;
     /// Normal used for emission side and light pdfs at a hit (matches sample_position).

@@ -4,6 +4,7 @@
 #include "core/geometry.h"
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace lpt {
 
@@ -37,6 +38,12 @@ inline Vec3f sample_cosine_hemisphere(const Vec2f& u) {
     const Vec2f d = sample_uniform_disk_concentric(u);
     return Vec3f(d.x(), d.y(), std::sqrt(std::max(0.f, 1.f - d.squaredNorm())));
 }
+
+/// sample_cosine_hemisphere for n sample pairs at once, the same floats (tests/core/test_warp.cpp): written with
+/// arithmetic selects so the compiler evaluates it 4 or 8 wide. The per-vertex warp is a long
+/// dependent chain (division, polynomial, square root) that one vertex at a time leaves the
+/// CPU waiting on; the tracer warps its whole shade queue with this instead.
+void sample_cosine_hemisphere_batch(const float* u0, const float* u1, float* x, float* y, float* z, size_t n);
 
 inline float pdf_cosine_hemisphere(const Vec3f& w) { return w.z() > 0.f ? w.z() * kInvPi : 0.f; }
 

@@ -27,17 +27,12 @@ public:
     }
 
     BSDFSample<N> sample(const BSDFContext& ctx, const Vec3f& wi, float, const Vec2f& u2) const override {
-        BSDFSample<N> bs;
-        if (cos_theta(wi) <= 0.f) return bs;
-        bs.wo = sample_cosine_hemisphere(u2);
-        bs.pdf = pdf_cosine_hemisphere(bs.wo);
-        if (!(bs.pdf > 0.f)) return BSDFSample<N>();  // wo on the horizon: eval would be 0
-        bs.lobe = kDiffuseReflection;
-        bs.weight = m_reflectance.eval(ctx);  // (R/pi cos) / (cos/pi), exactly
-        return bs;
+        if (cos_theta(wi) <= 0.f) return BSDFSample<N>();
+        return lambertian_sample<N>(Lambertian::OneSided, wi, sample_cosine_hemisphere(u2), m_reflectance.eval(ctx));
     }
 
     uint32_t flags() const override { return kDiffuseReflection; }
+    Lambertian lambertian() const override { return Lambertian::OneSided; }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_reflectance.eval(ctx); }
 
     /// ∂ρ/∂c · cos/π: 1 for the constant, g(uv) for .scale, 1 for .offset.

@@ -40,6 +40,9 @@ public:
     }
 
     uint32_t flags() const override { return m_nested->flags(); }
+    Lambertian lambertian() const override {
+        return m_nested->lambertian() == Lambertian::OneSided ? Lambertian::TwoSided : Lambertian::No;
+    }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_nested->albedo(ctx); }
 
     Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {

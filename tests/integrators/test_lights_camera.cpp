@@ -2,7 +2,10 @@
 #include "core/camera.h"
 #include "core/emitter.h"
 #include "core/sampler.h"
+#include "core/light_sampler.h"
+#include "core/scene_loader.h"
 #include "scene_fixtures.h"
+#include "test_util.h"
 #include <gtest/gtest.h>
 
 using namespace lpt;
@@ -49,6 +52,95 @@ TEST(LightSampler, PmfSumsToOneAndFollowsPower) {
     double sum = 0;
     for (size_t i = 0; i < scene.emitters.size(); ++i) sum += scene.lights.pmf(int(i));
     EXPECT_NEAR(sum, 1.0, 1e-6);
+}
+
+TEST(LightSampler, BatchEqualsOneByOne) {
+    // The tracer draws NEE samples with sample_batch: it must return sample()'s floats for flat
+    // triangle lights (vectorised geometry), a sphere light with interpolated normals and the
+    // environment (both fall back to sample()), reference points on, behind and beside lights.
+    const Scene scene = load_scene(test::write_temp_file("batch_lights.json", R"({
+      "integrator": {"light_sampling": "uniform"},
+      "camera": {"fov": 40, "width": 8, "height": 8, "to_world": {"lookat": {"origin": [0,0,4], "target": [0,0,0], "up": [0,1,0]}}},
+      "materials": {"m": {"type": "diffuse", "reflectance": 0.5}},
+      "shapes": [
+        {"id": "quad", "type": "rectangle", "material": "m", "to_world": {"translate": [0, 0, 2]}, "flip_normals": true,
+         "emitter": {"type": "area", "radiance": [4, 3, 2]}},
+        {"id": "ball", "type": "sphere", "material": "m", "to_world": {"translate": [1.5, 0, 0]},
+         "emitter": {"type": "area", "radiance": [1, 1, 1]}},
+        {"id": "floor", "type": "rectangle", "material": "m", "to_world": {"scale": 5}}],
+      "emitters": [{"type": "constant", "radiance": 0.2}]
+    })"));
+    ASSERT_EQ(scene.emitters.size(), 3u);
+    const size_t n = 3001;
+    LightBatch b;
+    b.resize(n);
+    for (size_t k = 0; k < n; ++k) {
+        const uint32_t i = uint32_t(k);
+        // Mostly near the lights; every 7th reference point on the quad light itself.
+        const Vec3f r = k % 7 == 0 ? Vec3f(0.f, 0.f, 2.f) : Vec3f(4 * sample_1d(4, i, 0, 0) - 2, 4 * sample_1d(4, i, 0, 1) - 2, 3 * sample_1d(4, i, 0, 2) - 0.5f);
+        b.rx[k] = r.x(); b.ry[k] = r.y(); b.rz[k] = r.z();
+        b.u_choice[k] = sample_1d(4, i, 0, 3);
+        b.u_pos0[k] = sample_1d(4, i, 0, 4);
+        b.u_pos1[k] = sample_1d(4, i, 0, 5);
+    }
+    scene.lights.sample_batch(scene.emitters, scene.shapes, n, b);
+    int valid = 0, kinds[3] = {0, 0, 0};
+    for (size_t k = 0; k < n; ++k) {
+        const LightSample one = scene.lights.sample(scene.emitters, scene.shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]), b.u_choice[k], Vec2f(b.u_pos0[k], b.u_pos1[k]));
+        const LightSample got = b.get(k);
+        ASSERT_EQ(got.emitter, one.emitter) << k;
+        ASSERT_EQ(got.pdf, one.pdf) << k;
+        if (!one.valid()) continue;
+        ++valid;
+        ++kinds[one.emitter];
+        for (int c = 0; c < 3; ++c) {
+            ASSERT_EQ(got.p[c], one.p[c]) << k;
+            ASSERT_EQ(got.n[c], one.n[c]) << k;
+            ASSERT_EQ(got.wi[c], one.wi[c]) << k;
+        }
+        ASSERT_EQ(got.dist, one.dist) << k;
+    }
+    EXPECT_GT(valid, int(n) / 3);
+    EXPECT_GT(kinds[0], 100);  // every kind of light was exercised
+    EXPECT_GT(kinds[1], 100);
+    EXPECT_GT(kinds[2], 100);
+}
+
+TEST(Camera, BatchRaysEqualOneByOne) {
+    // The tracer generates camera rays with generate_rays; they must be generate_ray's floats
+    // after filter.sample's offset, for the box and the tent filter, with a scaled, rotated camera.
+    Camera cam;
+    Eigen::Matrix4f scale = Eigen::Matrix4f::Identity();
+    scale.diagonal() << 1.5f, 1.5f, 1.5f, 1.f;
+    cam.world_from_camera = Transform::look_at(Vec3f(1, 2, 3), Vec3f(0, 0.5f, -1), Vec3f(0.2f, 1, 0)) * Transform(scale);
+    cam.width = 37;
+    cam.height = 23;
+    cam.fov = 52.f;
+    for (PixelFilter::Type type : {PixelFilter::Type::Box, PixelFilter::Type::Tent}) {
+        cam.filter.type = type;
+        cam.filter.radius = type == PixelFilter::Type::Tent ? 1.f : 0.5f;
+        const size_t n = 1003;
+        std::vector<float> px(n), py(n), u0(n), u1(n), o[8];
+        for (auto& a : o) a.resize(n);
+        for (size_t k = 0; k < n; ++k) {
+            px[k] = float(k % 37);
+            py[k] = float(k % 23);
+            u0[k] = k == 0 ? 0.5f : sample_1d(6, uint32_t(k), 0, 0);
+            u1[k] = k == 0 ? 0.f : sample_1d(6, uint32_t(k), 0, 1);
+        }
+        const Vec2f th = cam.tan_half_fov();
+        cam.generate_rays(n, px.data(), py.data(), u0.data(), u1.data(), th, {o[0].data(), o[1].data(), o[2].data(), o[3].data(), o[4].data(), o[5].data(), o[6].data(), o[7].data()});
+        for (size_t k = 0; k < n; ++k) {
+            const Vec2f off = cam.filter.sample(Vec2f(u0[k], u1[k]));
+            const Ray r = cam.generate_ray(Vec2f(px[k] + 0.5f + off.x(), py[k] + 0.5f + off.y()), th);
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_EQ(o[c][k], r.o[c]) << k;
+                ASSERT_EQ(o[3 + c][k], r.d[c]) << k;
+            }
+            ASSERT_EQ(o[6][k], r.tmin) << k;
+            ASSERT_EQ(o[7][k], r.tmax) << k;
+        }
+    }
 }
 
 TEST(Camera, CentreRayFollowsLookAtAndFovAxis) {
