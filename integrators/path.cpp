@@ -6,6 +6,7 @@
 #include "integrators/path.h"
 #include "core/envmap.h"
 #include "core/sampler.h"
+#include "core/warp.h"
 #include "integrators/wavefront_state.h"
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -33,6 +34,8 @@ struct Workspace {
     RayArrays rays[2];
     ShadowQueue<N> shadow;
     ShadeQueue shade;
+    AlignedVector<float> u_lobe, u_dir[2], cosine[3];  ///< per shade entry: BSDF randoms, warped direction
+    LightBatch lights;                                 ///< per shade entry: the NEE light sample
     PathState<N> paths;
     std::vector<uint32_t> queue[2];
 };
@@ -43,7 +46,10 @@ public:
     PathTracer(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, const Camera& camera,
                const LatentTerms<N>* terms, PathObserver<N>* observer)
         : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_terms(terms), m_obs(observer),
-          m_emission(!terms || terms->emission) {}
+          m_emission(!terms || terms->emission) {
+        m_lambertian.reserve(scene.shapes.size());
+        for (size_t s = 0; s < scene.shapes.size(); ++s) m_lambertian.push_back(spectra.bsdf_of(scene, int(s)).lambertian());
+    }
 
     /// Traces samples [s0, s0 + count) of every pixel in [x0,x1)×[y0,y1) and adds them to film.
     /// films[1], films[2] (Ĩa, Ĩc) are written only for latent terms.
@@ -80,10 +86,13 @@ public:
 private:
     void generate_camera_rays(Workspace<N>& ws, int x0, int y0, int x1, int s0, int count, size_t n, RenderStats& st) const {
         PathState<N>& p = ws.paths;
-        ws.rays[0].clear();
-        ws.queue[0].clear();
+        ws.queue[0].resize(n);
+        // Pixel, key and filter randoms per path, then all camera rays at once (Camera::generate_rays)
+        // straight into the ray arrays; the scratch reuses the BSDF stage's arrays.
+        for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0]})
+            if (a->size() < n) a->resize(n);
+        float *fx = ws.u_lobe.data(), *fy = ws.cosine[0].data(), *u0 = ws.u_dir[0].data(), *u1 = ws.u_dir[1].data();
         const int w = x1 - x0;
-        const Vec2f tan_half = m_camera.tan_half_fov();
         for (size_t k = 0; k < n; ++k) {
             int local = int(k) / count;
             int x = x0 + local % w, y = y0 + local / w;
@@ -91,8 +100,16 @@ private:
             p.sample[k] = uint32_t(s0 + int(k) % count);
             const SampleStream rng{m_opt.seed, p.pixel[k], p.sample[k]};
             p.key[k] = rng.key;
-            Vec2f offset = m_camera.filter.sample(Vec2f(rng.get(dim::kFilter), rng.get(dim::kFilter + 1)));
-            Ray r = m_camera.generate_ray(Vec2f(x + 0.5f + offset.x(), y + 0.5f + offset.y()), tan_half);
+            fx[k] = float(x);
+            fy[k] = float(y);
+            u0[k] = rng.get(dim::kFilter);
+            u1[k] = rng.get(dim::kFilter + 1);
+        }
+        RayArrays& rays = ws.rays[0];
+        rays.resize_for_fill(n);
+        m_camera.generate_rays(n, fx, fy, u0, u1, m_camera.tan_half_fov(),
+                               {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(), rays.dz.data(), rays.tnear.data(), rays.tfar.data()});
+        for (size_t k = 0; k < n; ++k) {
             p.beta[k].setOnes();
             p.radiance[k].setZero();
             p.ambient[k].setZero();
@@ -100,9 +117,8 @@ private:
             p.past_first[k] = 0;
             p.prev_pdf[k] = 0.f;
             p.prev_delta[k] = 1;  // a camera ray sees emitters with full weight, like a delta bounce
-            p.prev_p[k] = r.o;
-            ws.rays[0].push(r.o, r.d, r.tmin, r.tmax);
-            ws.queue[0].push_back(uint32_t(k));
+            p.prev_p[k] = rays.origin(k);
+            ws.queue[0][k] = uint32_t(k);
         }
         st.camera_rays += n;
     }
@@ -207,6 +223,20 @@ private:
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
         const bool nee_on = m_emission && m_opt.strategy != LightStrategy::Bsdf && !m_scene.lights.empty();
+        // Every entry's light sample first, as a batch (core/light_sampler.h): per vertex it is a
+        // long dependent chain of square roots and divisions.
+        if (!m_scene.lights.empty()) {
+            LightBatch& lb = ws.lights;
+            lb.resize(sq.size());
+            for (size_t k = 0; k < sq.size(); ++k) {
+                const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]]);
+                lb.rx[k] = sq.p[k].x(); lb.ry[k] = sq.p[k].y(); lb.rz[k] = sq.p[k].z();
+                lb.u_choice[k] = rng.get(dim::bounce(depth, dim::kLightChoice));
+                lb.u_pos0[k] = rng.get(dim::bounce(depth, dim::kLightPos));
+                lb.u_pos1[k] = rng.get(dim::bounce(depth, dim::kLightPos + 1));
+            }
+            m_scene.lights.sample_batch(m_scene.emitters, m_scene.shapes, sq.size(), lb);
+        }
         for (size_t k = 0; k < sq.size(); ++k) {
             const bool first = (sq.flags[k] & ShadeQueue::kFirst) != 0;
             const bool nee = nee_on && (sq.flags[k] & ShadeQueue::kContinue) && !m_spectra.is_delta(m_scene, sq.shape[k]);
@@ -220,9 +250,7 @@ private:
                 if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
-            const SampleStream rng = SampleStream::from_key(p.key[slot]);
-            LightSample ls = m_scene.lights.sample(m_scene.emitters, m_scene.shapes, sq.p[k], rng.get(dim::bounce(depth, dim::kLightChoice)),
-                                                   Vec2f(rng.get(dim::bounce(depth, dim::kLightPos)), rng.get(dim::bounce(depth, dim::kLightPos + 1))));
+            const LightSample ls = ws.lights.get(k);
             // A light sample behind the light or below the viewer's side of the surface is an
             // attached shadow: V = 0 without tracing.
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
@@ -274,15 +302,31 @@ private:
     void sample_bsdfs(Workspace<N>& ws, int cur, int depth) const {
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
-        for (size_t k = 0; k < sq.size(); ++k) {
+        // Every entry's random numbers and cosine-warped direction first: the warp is a long
+        // dependent chain that the batch evaluates 4-8 wide (core/warp.h); Lambertian vertices
+        // use it, other BSDFs sample from the same random numbers.
+        const size_t n = sq.size();
+        for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0], &ws.cosine[1], &ws.cosine[2]})
+            if (a->size() < n) a->resize(n);
+        for (size_t k = 0; k < n; ++k) {
+            const BsdfRandoms u = bsdf_randoms(SampleStream::from_key(p.key[sq.slot[k]]), uint32_t(depth));
+            ws.u_lobe[k] = u.lobe;
+            ws.u_dir[0][k] = u.dir[0];
+            ws.u_dir[1][k] = u.dir[1];
+        }
+        sample_cosine_hemisphere_batch(ws.u_dir[0].data(), ws.u_dir[1].data(), ws.cosine[0].data(), ws.cosine[1].data(), ws.cosine[2].data(), n);
+        for (size_t k = 0; k < n; ++k) {
             if (!(sq.flags[k] & ShadeQueue::kContinue)) continue;
             const uint32_t slot = sq.slot[k];
             const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
             const SampleStream rng = SampleStream::from_key(p.key[slot]);
             BSDFContext ctx;
             ctx.uv = sq.uv[k];
-            const BsdfRandoms u = bsdf_randoms(rng, uint32_t(depth));
-            BSDFSample<N> bs = bsdf.sample(ctx, sq.wi[k], u.lobe, Vec2f(u.dir[0], u.dir[1]));
+            const Lambertian lambertian = m_lambertian[sq.shape[k]];
+            const BSDFSample<N> bs =
+                lambertian != Lambertian::No
+                    ? lambertian_sample<N>(lambertian, sq.wi[k], Vec3f(ws.cosine[0][k], ws.cosine[1][k], ws.cosine[2][k]), bsdf.albedo(ctx))
+                    : bsdf.sample(ctx, sq.wi[k], ws.u_lobe[k], Vec2f(ws.u_dir[0][k], ws.u_dir[1][k]));
             if (!bs.valid()) continue;
             Spectrum<N> beta = p.beta[slot] * bs.weight;
             // |throughput|: sign-safe for latent spectra.
@@ -324,6 +368,7 @@ private:
     const LatentTerms<N>* m_terms;  ///< null for plain (RGB) rendering
     PathObserver<N>* m_obs;         ///< null unless an adjoint is replaying
     const bool m_emission;          ///< Ĩe on
+    std::vector<Lambertian> m_lambertian;  ///< per shape: sampled from the batch-warped direction
 };
 
 /// Shared driver: tiles in parallel, each tile's pixels owned by one task (deterministic).

@@ -1,4 +1,5 @@
 #include "integrators/wavefront_state.h"
+#include <algorithm>
 
 namespace lpt {
 
@@ -22,6 +23,12 @@ size_t RayArrays::push(const Vec3f& o, const Vec3f& d, float tmin, float tmax) {
     tnear[i] = tmin; tfar[i] = tmax;
     geom[i] = RTC_INVALID_GEOMETRY_ID;  // Embree leaves it untouched on a miss
     return i;
+}
+
+void RayArrays::resize_for_fill(size_t n) {
+    if (ox.size() < n) reserve(n);
+    size = n;
+    std::fill(geom.begin(), geom.begin() + n, RTC_INVALID_GEOMETRY_ID);
 }
 
 void RayArrays::intersect(RTCScene scene, bool coherent) {

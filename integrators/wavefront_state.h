@@ -26,6 +26,8 @@ struct RayArrays {
     void clear() { size = 0; }
     /// Appends a ray; returns its index.
     size_t push(const Vec3f& o, const Vec3f& d, float tmin, float tmax);
+    /// n rays whose origins, directions and t ranges the caller writes in place (camera rays).
+    void resize_for_fill(size_t n);
     Vec3f origin(size_t i) const { return Vec3f(ox[i], oy[i], oz[i]); }
     Vec3f direction(size_t i) const { return Vec3f(dx[i], dy[i], dz[i]); }
     bool hit(size_t i) const { return geom[i] != RTC_INVALID_GEOMETRY_ID; }
