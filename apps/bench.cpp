@@ -95,6 +95,8 @@ double trace_pool(const Scene& s, const RayPool& pool, uint64_t count, bool occl
     return seconds_since(t0);
 }
 
+constexpr int kReps = 9;  ///< alternating pt / raw measurements per scene (odd: one median)
+
 struct Row {
     std::string name;
     size_t triangles;
@@ -117,18 +119,19 @@ Row bench_scene(const std::string& name, const Scene& scene, const BenchArgs& a)
     RayPool ext = surface_pool(scene, pool_n, false);
     RayPool shd = surface_pool(scene, pool_n, true);
     // A raw pass lasts a few tenths of a second, so one run swings by ±20% with whatever else
-    // the machine does: alternate the two measurements and keep each one's median.
+    // the machine does (and the ratio of one 5-run median still moved by ±3 points between
+    // invocations): alternate the two measurements 9 times and keep each one's median.
     std::vector<double> pt_s, raw_s;
-    for (int rep = 0; rep < 5; ++rep) {
+    for (int rep = 0; rep < kReps; ++rep) {
         render_path<3>(scene, spectra, opt, &row.pt);
         pt_s.push_back(row.pt.seconds);
         raw_s.push_back(trace_pool(scene, cam, row.pt.camera_rays, false, true) + trace_pool(scene, ext, row.pt.extension_rays, false, false) +
                         trace_pool(scene, shd, row.pt.shadow_rays, true, false));
     }
-    std::nth_element(pt_s.begin(), pt_s.begin() + 2, pt_s.end());
-    std::nth_element(raw_s.begin(), raw_s.begin() + 2, raw_s.end());
-    row.pt.seconds = pt_s[2];
-    row.raw_seconds = raw_s[2];
+    std::nth_element(pt_s.begin(), pt_s.begin() + kReps / 2, pt_s.end());
+    std::nth_element(raw_s.begin(), raw_s.begin() + kReps / 2, raw_s.end());
+    row.pt.seconds = pt_s[kReps / 2];
+    row.raw_seconds = raw_s[kReps / 2];
     return row;
 }
 
@@ -168,8 +171,8 @@ int run_bench(const BenchArgs& a) {
            << ",\"pt_mrays_per_s\":" << pt << ",\"raw_mrays_per_s\":" << raw << ",\"ratio\":" << pt / raw << "}";
     }
     js << "]\n";
-    std::printf("(%d spp at %dx%d; raw = Embree stream calls alone on the same numbers of camera, extension and shadow rays; medians of 5 "
-                "alternating runs)\n", a.spp, a.res, a.res);
+    std::printf("(%d spp at %dx%d; raw = Embree stream calls alone on the same numbers of camera, extension and shadow rays; medians of %d "
+                "alternating runs)\n", a.spp, a.res, a.res, kReps);
     if (!a.out_json.empty()) write_text_atomic(a.out_json, js.str());
     return 0;
 }
