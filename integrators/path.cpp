@@ -35,6 +35,7 @@ struct Workspace {
     ShadowQueue<N> shadow;
     ShadeQueue shade;
     AlignedVector<float> u_lobe, u_dir[2], cosine[3];  ///< per shade entry: BSDF randoms, warped direction
+    AlignedVector<float> film[2];                      ///< per camera ray: pixel column and row
     LightBatch lights;                                 ///< per shade entry: the NEE light sample
     PathState<N> paths;
     std::vector<uint32_t> queue[2];
@@ -88,10 +89,10 @@ private:
         PathState<N>& p = ws.paths;
         ws.queue[0].resize(n);
         // Pixel, key and filter randoms per path, then all camera rays at once (Camera::generate_rays)
-        // straight into the ray arrays; the scratch reuses the BSDF stage's arrays.
-        for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0]})
+        // straight into the ray arrays; the filter randoms borrow the BSDF stage's arrays.
+        for (auto* a : {&ws.film[0], &ws.film[1], &ws.u_dir[0], &ws.u_dir[1]})
             if (a->size() < n) a->resize(n);
-        float *fx = ws.u_lobe.data(), *fy = ws.cosine[0].data(), *u0 = ws.u_dir[0].data(), *u1 = ws.u_dir[1].data();
+        float *fx = ws.film[0].data(), *fy = ws.film[1].data(), *u0 = ws.u_dir[0].data(), *u1 = ws.u_dir[1].data();
         const int w = x1 - x0;
         for (size_t k = 0; k < n; ++k) {
             int local = int(k) / count;
