@@ -117,6 +117,96 @@ def img_tag(path, width=160):
     return f'<td><img width="{width}" src="data:image/png;base64,{data}"/></td>'
 
 
+def write_atomic(path, text):
+    """Writes text to path through a temporary file and a rename: never a truncated result."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def write_outputs(a, summary, failures, image_res, fit_its, ref_its, frames):
+    """summary.md/json, the SVG plots and report.html for the scenes finished so far; called
+    after every scene so an interrupted multi-scene run keeps its finished scenes' tables."""
+    # Tables (markdown) and plots.
+    colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
+               "baseline+refiner": "#e377c2"}
+    md = ["# latentpt experiment summary", "",
+          f"settings: image {image_res}² (latents {image_res // 8}²), reference spp per scene below, stage 1 {fit_its} iterations, "
+          f"refiner {ref_its} iterations, frames {frames or 'as in the edit files'}, edited latents {a.spp} spp", ""]
+    for scene, s in summary.items():
+        t = s["training_view"]
+        md += [f"## {scene}", "", f"References: {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
+               ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
+                         for k in ("rendered", "refined", "vae_roundtrip") if k in t), "",
+               "| edit | config | LPIPS | MSE×100 | latent D-SSIM |", "|---|---|---|---|---|"]
+        for kind, table in s["edits"].items():
+            for key, label in CONFIGS:
+                r = table[key]
+                md.append(f"| {kind} | {label} | {r['rgb_lpips']:.4f} | {r['rgb_mse_x100']:.4f} | {r['latent_dssim']:.4f} |")
+            for metric, ylabel in (("lpips", "LPIPS (decoded)"), ("dssim", "D-SSIM (latent)")):
+                svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in CONFIGS], ylabel)
+                write_atomic(os.path.join(a.out, f"{scene}_{kind}_{metric}.svg"), svg)
+        if "convergence" in s:
+            md += ["", "Convergence of the eac fit vs latent spp (latent D-SSIM / decoded LPIPS; rendered → refined):", "",
+                   "| view | spp | D-SSIM | refined D-SSIM | LPIPS | refined LPIPS |", "|---|---|---|---|---|---|"]
+            for view, by_spp in s["convergence"].items():
+                for spp, r in by_spp.items():
+                    md.append(f"| {view} | {spp} | {r['latent_dssim']:.4f} | {r['refined_latent_dssim']:.4f} | {r['rgb_lpips']:.4f} | {r['refined_rgb_lpips']:.4f} |")
+                svg = svg_plot(f"{scene}, {view} view: error vs spp ({', '.join(map(str, by_spp))})",
+                               [(lab, col, [r[k] for r in by_spp.values()]) for k, lab, col in
+                                (("latent_dssim", "D-SSIM", "#1f77b4"), ("refined_latent_dssim", "D-SSIM refined", "#2ca02c"),
+                                 ("rgb_lpips", "LPIPS", "#ff7f0e"), ("refined_rgb_lpips", "LPIPS refined", "#d62728"))], "error")
+                write_atomic(os.path.join(a.out, f"{scene}_convergence_{view}.svg"), svg)
+        if "wall_seconds" in s:
+            md += ["", f"Wall time of this run for {scene}: {s['wall_seconds'] / 60:.1f} min (budget 120 min; " +
+                   ", ".join(f"{k} {v / 60:.1f}" for k, v in s["stages"].items()) + " min; finished results reused count ~0)"]
+        if "equal_error" in s:
+            md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
+                   s["equal_error"].rstrip(), "```"]
+        md.append("")
+    if failures:
+        md += ["## Ordering check failed", ""] + [f"- {x}" for x in failures]
+    write_atomic(os.path.join(a.out, "summary.md"), "\n".join(md) + "\n")
+    write_atomic(os.path.join(a.out, "summary.json"), json.dumps(summary, indent=1))
+
+    # Self-contained HTML report.
+    h = ["<!doctype html><html><head><meta charset='utf-8'><title>latentpt experiments</title>",
+         "<style>body{font-family:sans-serif;margin:2em;max-width:1200px} table{border-collapse:collapse} "
+         "td,th{border:1px solid #ccc;padding:3px 8px} img{image-rendering:pixelated}</style></head><body>",
+         "<h1>latentpt experiments</h1>", f"<p>{html.escape(md[2])}</p>"]
+    for scene, s in summary.items():
+        h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
+        for kind, table in s["edits"].items():
+            for key, label in CONFIGS:
+                r = table[key]
+                h.append(f"<tr><td>{kind}</td><td>{html.escape(label)}</td><td>{r['rgb_lpips']:.4f}</td><td>{r['rgb_mse_x100']:.4f}</td>"
+                         f"<td>{r['latent_dssim']:.4f}</td></tr>")
+        h.append("</table>")
+        for view in s.get("convergence", {}):
+            with open(os.path.join(a.out, f"{scene}_convergence_{view}.svg")) as f:
+                h.append(f.read())
+        for kind in s["edits"]:
+            for metric in ("lpips", "dssim"):
+                with open(os.path.join(a.out, f"{scene}_{kind}_{metric}.svg")) as f:
+                    h.append(f.read())
+            n = len(s["edits"][kind]["e"]["per_frame_lpips"])
+            h.append(f"<h3>{kind}: reference / Ĩe / +Ĩa+Ĩc / +refiner / baseline + refiner</h3><table>")
+            for i in sorted({0, n // 2, n - 1}):
+                d = os.path.join(a.out, scene)
+                h.append("<tr><td>frame %d</td>" % i + img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_reference.png")) +
+                         img_tag(os.path.join(d, f"{kind}_e", f"frame_{i:04d}.png")) +
+                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_rendered.png")) +
+                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}.png")) +
+                         img_tag(os.path.join(d, f"{kind}_baseline", f"frame_{i:04d}.png")) + "</tr>")
+            h.append("</table>")
+    if failures:
+        h.append("<h2>Ordering check failed</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in failures) + "</ul>")
+    h.append("</body></html>")
+    write_atomic(os.path.join(a.out, "report.html"), "\n".join(h))
+    return md
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="one scene, small and short; checks the ablation ordering (CI)")
@@ -250,88 +340,9 @@ def main():
         summary[scene]["equal_error"] = r.stdout
         stages["equal-error benchmark"] = time.time() - stage_t0
         summary[scene]["wall_seconds"] = time.time() - scene_t0
+        write_outputs(a, summary, failures, image_res, fit_its, ref_its, frames)
 
-    # Tables (markdown) and plots.
-    colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
-               "baseline+refiner": "#e377c2"}
-    md = ["# latentpt experiment summary", "",
-          f"settings: image {image_res}² (latents {image_res // 8}²), reference spp per scene below, stage 1 {fit_its} iterations, "
-          f"refiner {ref_its} iterations, frames {frames or 'as in the edit files'}, edited latents {a.spp} spp", ""]
-    for scene, s in summary.items():
-        t = s["training_view"]
-        md += [f"## {scene}", "", f"References: {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
-               ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
-                         for k in ("rendered", "refined", "vae_roundtrip") if k in t), "",
-               "| edit | config | LPIPS | MSE×100 | latent D-SSIM |", "|---|---|---|---|---|"]
-        for kind, table in s["edits"].items():
-            for key, label in CONFIGS:
-                r = table[key]
-                md.append(f"| {kind} | {label} | {r['rgb_lpips']:.4f} | {r['rgb_mse_x100']:.4f} | {r['latent_dssim']:.4f} |")
-            for metric, ylabel in (("lpips", "LPIPS (decoded)"), ("dssim", "D-SSIM (latent)")):
-                svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in CONFIGS], ylabel)
-                with open(os.path.join(a.out, f"{scene}_{kind}_{metric}.svg"), "w") as f:
-                    f.write(svg)
-        if "convergence" in s:
-            md += ["", "Convergence of the eac fit vs latent spp (latent D-SSIM / decoded LPIPS; rendered → refined):", "",
-                   "| view | spp | D-SSIM | refined D-SSIM | LPIPS | refined LPIPS |", "|---|---|---|---|---|---|"]
-            for view, by_spp in s["convergence"].items():
-                for spp, r in by_spp.items():
-                    md.append(f"| {view} | {spp} | {r['latent_dssim']:.4f} | {r['refined_latent_dssim']:.4f} | {r['rgb_lpips']:.4f} | {r['refined_rgb_lpips']:.4f} |")
-                svg = svg_plot(f"{scene}, {view} view: error vs spp ({', '.join(map(str, by_spp))})",
-                               [(lab, col, [r[k] for r in by_spp.values()]) for k, lab, col in
-                                (("latent_dssim", "D-SSIM", "#1f77b4"), ("refined_latent_dssim", "D-SSIM refined", "#2ca02c"),
-                                 ("rgb_lpips", "LPIPS", "#ff7f0e"), ("refined_rgb_lpips", "LPIPS refined", "#d62728"))], "error")
-                with open(os.path.join(a.out, f"{scene}_convergence_{view}.svg"), "w") as f:
-                    f.write(svg)
-        if "wall_seconds" in s:
-            md += ["", f"Wall time of this run for {scene}: {s['wall_seconds'] / 60:.1f} min (budget 120 min; " +
-                   ", ".join(f"{k} {v / 60:.1f}" for k, v in s["stages"].items()) + " min; finished results reused count ~0)"]
-        if "equal_error" in s:
-            md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
-                   s["equal_error"].rstrip(), "```"]
-        md.append("")
-    if failures:
-        md += ["## Ordering check failed", ""] + [f"- {x}" for x in failures]
-    with open(os.path.join(a.out, "summary.md"), "w") as f:
-        f.write("\n".join(md) + "\n")
-    with open(os.path.join(a.out, "summary.json"), "w") as f:
-        json.dump(summary, f, indent=1)
-
-    # Self-contained HTML report.
-    h = ["<!doctype html><html><head><meta charset='utf-8'><title>latentpt experiments</title>",
-         "<style>body{font-family:sans-serif;margin:2em;max-width:1200px} table{border-collapse:collapse} "
-         "td,th{border:1px solid #ccc;padding:3px 8px} img{image-rendering:pixelated}</style></head><body>",
-         "<h1>latentpt experiments</h1>", f"<p>{html.escape(md[2])}</p>"]
-    for scene, s in summary.items():
-        h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
-        for kind, table in s["edits"].items():
-            for key, label in CONFIGS:
-                r = table[key]
-                h.append(f"<tr><td>{kind}</td><td>{html.escape(label)}</td><td>{r['rgb_lpips']:.4f}</td><td>{r['rgb_mse_x100']:.4f}</td>"
-                         f"<td>{r['latent_dssim']:.4f}</td></tr>")
-        h.append("</table>")
-        for view in s.get("convergence", {}):
-            with open(os.path.join(a.out, f"{scene}_convergence_{view}.svg")) as f:
-                h.append(f.read())
-        for kind in s["edits"]:
-            for metric in ("lpips", "dssim"):
-                with open(os.path.join(a.out, f"{scene}_{kind}_{metric}.svg")) as f:
-                    h.append(f.read())
-            n = len(s["edits"][kind]["e"]["per_frame_lpips"])
-            h.append(f"<h3>{kind}: reference / Ĩe / +Ĩa+Ĩc / +refiner / baseline + refiner</h3><table>")
-            for i in sorted({0, n // 2, n - 1}):
-                d = os.path.join(a.out, scene)
-                h.append("<tr><td>frame %d</td>" % i + img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_reference.png")) +
-                         img_tag(os.path.join(d, f"{kind}_e", f"frame_{i:04d}.png")) +
-                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_rendered.png")) +
-                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}.png")) +
-                         img_tag(os.path.join(d, f"{kind}_baseline", f"frame_{i:04d}.png")) + "</tr>")
-            h.append("</table>")
-    if failures:
-        h.append("<h2>Ordering check failed</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in failures) + "</ul>")
-    h.append("</body></html>")
-    with open(os.path.join(a.out, "report.html"), "w") as f:
-        f.write("\n".join(h))
+    md = write_outputs(a, summary, failures, image_res, fit_its, ref_its, frames)
     print("\n".join(md))
     print(f"wrote {a.out}/summary.md, summary.json, report.html and plots")
     if failures:
