@@ -1,4 +1,5 @@
 #include "core/light_sampler.h"
+#include "core/vectorize.h"
 #include "core/envmap.h"
 #include "core/spectrum.h"
 #include <algorithm>
@@ -70,10 +71,10 @@ void LightBatch::resize(size_t n) {
 namespace {
 
 // The geometry of sample_area_light for flat triangles, lane by lane in the same float
-// operations and order as Shape::sample_position + sample_area_light + the pmf product (no
-// FMA in the AVX2 clone: fused rounding would differ from the scalar code). Invalid lanes
+// operations and order as Shape::sample_position + sample_area_light + the pmf product
+// (core/vectorize.h). Invalid lanes
 // (reference point on the light, light facing away) get pdf 0, as sample() does.
-__attribute__((target_clones("avx2", "default")))
+LPT_VECTOR_CLONES
 void triangle_light_geometry(LightBatch& b, size_t n) {
     const float* __restrict rx = b.rx.data(); const float* __restrict ry = b.ry.data(); const float* __restrict rz = b.rz.data();
     const float* __restrict u0 = b.u_pos0.data(); const float* __restrict u1 = b.u_pos1.data();

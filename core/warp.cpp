@@ -1,4 +1,5 @@
 #include "core/warp.h"
+#include "core/vectorize.h"
 #include <algorithm>
 
 namespace lpt {
@@ -13,9 +14,8 @@ Vec3f sample_uniform_sphere(const Vec2f& u) {
 float pdf_uniform_sphere(const Vec3f&) { return 0.25f * kInvPi; }
 
 // m in {0, 1} blends exactly (products with 0 and 1 and sums with 0 are exact, up to the sign
-// of a zero), so every lane gives the float of sample_uniform_disk_concentric's taken branch. AVX2
-// clone without FMA: a fused multiply-add would round differently from the scalar warp.
-__attribute__((target_clones("avx2", "default")))
+// of a zero), so every lane gives the float of sample_uniform_disk_concentric's taken branch.
+LPT_VECTOR_CLONES
 void sample_cosine_hemisphere_batch(const float* __restrict u0, const float* __restrict u1, float* __restrict x_out,
                                     float* __restrict y_out, float* __restrict z_out, size_t n) {
     for (size_t i = 0; i < n; ++i) {

@@ -1,6 +1,7 @@
 // Perspective camera: fov (degrees) + fov_axis (x, y, smaller, larger), to_world; pixel filter
 // box (radius 0.5) or tent (radius 1). Equations: docs/sampling.md (camera).
 #include "core/camera.h"
+#include "core/vectorize.h"
 #include "core/warp.h"
 #include <cmath>
 
@@ -78,7 +79,7 @@ inline void camera_rays_for(size_t n, float radius, float width, float height, c
     }
 }
 
-__attribute__((target_clones("avx2", "default")))
+LPT_VECTOR_CLONES
 void camera_rays(size_t n, bool tent, float radius, float width, float height, const Vec2f th, const Eigen::Matrix4f m, float near_clip,
                  float far_clip, const float* px, const float* py, const float* u0, const float* u1, float* ox, float* oy, float* oz,
                  float* dx, float* dy, float* dz, float* tnear, float* tfar) {
