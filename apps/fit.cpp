@@ -126,7 +126,13 @@ int run_fit(const FitArgs& a) {
         return true;
     };
     state = fit_latent(model, target, w, h, o, state, on_iteration);
-    if (!a.quiet) std::fprintf(stderr, "\n[fit] best smoothed loss %.5f at iteration %d; %d refused steps\n", state.best_loss, state.best_iteration, state.skipped_steps);
+    if (!a.quiet) {
+        // With --patience 0 nothing tracks a best iteration: the last parameters are kept.
+        if (state.best_iteration >= 0)
+            std::fprintf(stderr, "\n[fit] best smoothed loss %.5f at iteration %d; %d refused steps\n", state.best_loss, state.best_iteration, state.skipped_steps);
+        else
+            std::fprintf(stderr, "\n[fit] early stopping off: the last iteration's parameters are kept; %d refused steps\n", state.skipped_steps);
+    }
     save_checkpoint(o.checkpoint_dir, model, state);
 
     // Final render of the best parameters at --final-spp.
