@@ -138,13 +138,7 @@ void LightSampler::sample_batch(const std::vector<Emitter>& emitters, const std:
             b.pdf[k] *= m_pmf[b.emitter[k]];
             continue;
         }
-        const LightSample ls = sample(emitters, shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]), b.u_choice[k], Vec2f(b.u_pos0[k], b.u_pos1[k]));
-        b.px[k] = ls.p.x(); b.py[k] = ls.p.y(); b.pz[k] = ls.p.z();
-        b.nx[k] = ls.n.x(); b.ny[k] = ls.n.y(); b.nz[k] = ls.n.z();
-        b.wx[k] = ls.wi.x(); b.wy[k] = ls.wi.y(); b.wz[k] = ls.wi.z();
-        b.dist[k] = ls.dist;
-        b.pdf[k] = ls.pdf;
-        b.emitter[k] = ls.emitter;
+        b.set(k, sample(emitters, shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]), b.u_choice[k], Vec2f(b.u_pos0[k], b.u_pos1[k])));
     }
 }
 

@@ -43,6 +43,14 @@ struct LightBatch {
     std::vector<int> emitter;
     std::vector<uint8_t> scalar;  ///< 1: filled by sample() (environment, interpolated normals)
     void resize(size_t n);
+    void set(size_t k, const LightSample& ls) {
+        px[k] = ls.p.x(); py[k] = ls.p.y(); pz[k] = ls.p.z();
+        nx[k] = ls.n.x(); ny[k] = ls.n.y(); nz[k] = ls.n.z();
+        wx[k] = ls.wi.x(); wy[k] = ls.wi.y(); wz[k] = ls.wi.z();
+        dist[k] = ls.dist;
+        pdf[k] = ls.pdf;
+        emitter[k] = ls.emitter;
+    }
     LightSample get(size_t k) const {
         LightSample ls;
         ls.p = Vec3f(px[k], py[k], pz[k]);
