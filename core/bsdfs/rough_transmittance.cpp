@@ -1,0 +1,150 @@
+// Rough-coating transmittance tables: direct quadrature (docs/bsdfs.md (26), (42)) and the
+// cached log-α Hermite interpolation of it (46).
+#include "core/bsdfs/rough_transmittance.h"
+#include "core/bsdfs/fresnel.h"
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
+
+namespace lpt {
+namespace {
+
+constexpr int K = 32;             // quadrature grid K×K per table entry
+constexpr double kNodeStep = 0.125;  // Δs between nodes in s = ln(α / kMinAlpha)
+
+// Unclamped t(μ_j) and ∂t/∂α(μ_j) at one α: the raw node data.
+struct RawTables {
+    std::array<double, kTransmittanceRes> t{}, dt{};
+};
+
+// A(μ) by a midpoint grid over the microfacet sampler's unit square (smooth in u, so O(K^-2)).
+double albedo(const MicrofacetDistribution& distr, float eta, const Vec3f& wi) {
+    double sum = 0.0;
+    for (int a = 0; a < K; ++a)
+        for (int b = 0; b < K; ++b) {
+            Vec3f m = distr.sample(wi, Vec2f((a + 0.5f) / K, (b + 0.5f) / K));
+            Vec3f wo = reflect(wi, m);
+            if (wo.z() <= 0.f) continue;
+            sum += fresnel_dielectric(wi.dot(m), eta).R * distr.sample_weight(wi, wo, m);
+        }
+    return sum / (K * K);
+}
+
+// ∂A/∂α at incidence wi (docs/bsdfs.md (42)): ∫ R(wi·h) ∂(D G)/∂α / (4 mu) dωo over the
+// upper hemisphere, with the directions held fixed (only the integrand moves with α),
+// importance-sampled by the microfacet sampler at the current α over a midpoint grid:
+// E_u[R (∂D G + D ∂G)(wo·m) / (mu p(m | wi))], p(m | wi) from (8)/(9), the reflection
+// Jacobian (10) turning p(m) into p(wo). For Beckmann, d ln D/dα = 2 (tan²θm/α² - 1)/α
+// grows like -ln(1 - u1) toward u1 = 1, which a midpoint rule integrates poorly; there
+// u1 = 1 - (1 - v)², du1 = 2 (1 - v) dv smooths the endpoint ((1 - v) ln(1 - v) → 0).
+double dalbedo_dalpha(const MicrofacetDistribution& distr, float eta, const Vec3f& wi) {
+    const bool beckmann = distr.type() == MicrofacetType::Beckmann;
+    double mu = wi.z(), sum = 0.0;
+    for (int a = 0; a < K; ++a) {
+        double v = (a + 0.5) / K, u1 = v, jac = 1.0;
+        if (beckmann) u1 = 1.0 - (1.0 - v) * (1.0 - v), jac = 2.0 * (1.0 - v);
+        for (int b = 0; b < K; ++b) {
+            Vec3f m = distr.sample(wi, Vec2f(float(u1), (b + 0.5f) / K));
+            Vec3f wo = reflect(wi, m);
+            float wo_m = wo.dot(m);
+            if (wo.z() <= 0.f || wo_m <= 0.f) continue;
+            double pm = distr.pdf(wi, m);
+            if (!(pm > 0.0)) continue;
+            double dDG = distr.dDG_dalpha(wi, wo, m);
+            sum += jac * fresnel_dielectric(wi.dot(m), eta).R * dDG * wo_m / (mu * pm);
+        }
+    }
+    return sum / (K * K);
+}
+
+RawTables raw_tables(MicrofacetType type, float eta, float alpha) {
+    MicrofacetDistribution distr(type, alpha);
+    RawTables r;
+    for (int j = 0; j < kTransmittanceRes; ++j) {
+        float mu = std::max(1e-6f, float(j) / (kTransmittanceRes - 1));
+        Vec3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
+        r.t[j] = double(1.f - float(albedo(distr, eta, wi)));
+        r.dt[j] = -dalbedo_dalpha(distr, eta, wi);
+    }
+    return r;
+}
+
+// Exact ∫ (linear segment) 2 mu dmu of a table, per segment [m0, m1] with values t0, t1.
+double mean_cosine_weighted(const std::array<float, kTransmittanceRes>& table) {
+    double total = 0.0, h = 1.0 / (kTransmittanceRes - 1);
+    for (int j = 0; j + 1 < kTransmittanceRes; ++j) {
+        double m0 = j * h, m1 = m0 + h, t0 = table[j], t1 = table[j + 1];
+        double slope = (t1 - t0) / h;
+        double c = t0 - slope * m0;  // t = c + slope * mu
+        total += c * (m1 * m1 - m0 * m0) + slope * 2.0 / 3.0 * (m1 * m1 * m1 - m0 * m0 * m0);
+    }
+    return total;
+}
+
+// Clamps t to [0, 1] (a clamped entry is locally constant in α) and integrates T̄, ∂T̄/∂α.
+TransmittanceTable finish(const std::array<double, kTransmittanceRes>& t, const std::array<double, kTransmittanceRes>& dt) {
+    TransmittanceTable out;
+    for (int j = 0; j < kTransmittanceRes; ++j) {
+        float tf = float(t[j]);
+        out.t[j] = std::clamp(tf, 0.f, 1.f);
+        out.dt[j] = tf == out.t[j] ? float(dt[j]) : 0.f;
+    }
+    out.mean = float(mean_cosine_weighted(out.t));
+    out.dmean = float(mean_cosine_weighted(out.dt));
+    return out;
+}
+
+// A node: raw t and its slope in s = ln α, m = α ∂t/∂α, at α_k = kMinAlpha exp(k Δs).
+struct Node {
+    std::array<double, kTransmittanceRes> t{}, dt_ds{};
+};
+
+std::mutex g_mutex;
+std::map<std::tuple<int, float, int>, std::unique_ptr<const Node>> g_nodes;
+
+const Node& node(MicrofacetType type, float eta, int k) {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    auto& slot = g_nodes[{int(type), eta, k}];
+    if (!slot) {
+        float alpha_k = float(MicrofacetDistribution::kMinAlpha * std::exp(k * kNodeStep));
+        RawTables r = raw_tables(type, eta, alpha_k);
+        auto n = std::make_unique<Node>();
+        for (int j = 0; j < kTransmittanceRes; ++j) n->t[j] = r.t[j], n->dt_ds[j] = double(alpha_k) * r.dt[j];
+        slot = std::move(n);
+    }
+    return *slot;
+}
+
+}  // namespace
+
+TransmittanceTable rough_transmittance_direct(MicrofacetType type, float eta, float alpha) {
+    RawTables r = raw_tables(type, eta, std::max(alpha, MicrofacetDistribution::kMinAlpha));
+    return finish(r.t, r.dt);
+}
+
+TransmittanceTable rough_transmittance(MicrofacetType type, float eta, float alpha) {
+    // docs/bsdfs.md (46): cubic Hermite in s over [s_k, s_k+1], x = (s − s_k)/Δs.
+    double s = std::log(std::max(double(alpha), double(MicrofacetDistribution::kMinAlpha)) / MicrofacetDistribution::kMinAlpha) / kNodeStep;
+    int k = int(std::floor(s));
+    double x = s - k, x2 = x * x, x3 = x2 * x;
+    const Node& a = node(type, eta, k);
+    const Node& b = node(type, eta, k + 1);
+    double h00 = 2 * x3 - 3 * x2 + 1, h10 = x3 - 2 * x2 + x, h01 = -2 * x3 + 3 * x2, h11 = x3 - x2;
+    double d00 = 6 * x2 - 6 * x, d10 = 3 * x2 - 4 * x + 1, d01 = -6 * x2 + 6 * x, d11 = 3 * x2 - 2 * x;
+    double ds_dalpha = 1.0 / double(alpha);  // ∂(ln α)/∂α; the 1/Δs of x is applied per term
+    std::array<double, kTransmittanceRes> t, dt;
+    for (int j = 0; j < kTransmittanceRes; ++j) {
+        t[j] = h00 * a.t[j] + kNodeStep * (h10 * a.dt_ds[j] + h11 * b.dt_ds[j]) + h01 * b.t[j];
+        dt[j] = ((d00 * a.t[j] + d01 * b.t[j]) / kNodeStep + d10 * a.dt_ds[j] + d11 * b.dt_ds[j]) * ds_dalpha;
+    }
+    return finish(t, dt);
+}
+
+size_t rough_transmittance_nodes_built() {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    return g_nodes.size();
+}
+
+}  // namespace lpt
