@@ -270,8 +270,8 @@ TEST(BSDFAlpha, EvalGradMatchesCentralDifferences) {
     // Exact derivatives (roughconductor, roughdielectric, roughplastic's specular lobe and its
     // diffuse lobe, whose t(μ) and ∂t/∂α tables are an interpolant and its exact derivative,
     // docs/bsdfs.md (46); twosided from both faces). eval is float, so its differences need a
-    // larger step than (37)-(39)'s h = 1e-4 α: h = 2e-3 α with Richardson extrapolation. Truncation ~h⁴ f⁽⁵⁾/30 < 2e-4
-    // relative down to 70 e-folds of a Beckmann tail; rounding ~10 eps |f| / (2h) per difference,
+    // larger step than (37)-(39)'s h = 1e-4 α: h = 2e-3 α with Richardson extrapolation.
+    // Truncation ~h⁴ f⁽⁵⁾/30 < 2e-4 relative down to 70 e-folds of a Beckmann tail; rounding ~10 eps |f| / (2h) per difference,
     // ~3e-4 |f|/α after extrapolation. Hence the tolerance 1e-3 (|fd| + |f|/α): relative 1e-3 of
     // the derivative, floored at 1e-3 of the natural scale |f|/α where ∂f/∂α changes sign, and
     // at 1e-30 absolute: far tails where D or f is (nearly) subnormal carry no digits.
