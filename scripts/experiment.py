@@ -160,7 +160,7 @@ def write_outputs(a, summary, failures, image_res, fit_its, ref_its, frames):
                 write_atomic(os.path.join(a.out, f"{scene}_convergence_{view}.svg"), svg)
         if "wall_seconds" in s:
             md += ["", f"Wall time of this run for {scene}: {s['wall_seconds'] / 60:.1f} min (budget 120 min; " +
-                   ", ".join(f"{k} {v / 60:.1f}" for k, v in s["stages"].items()) + " min; finished results reused count ~0)"]
+                   ", ".join(f"{k} {v / 60:.1f}" for k, v in s["stages"].items()) + " min; results reused from an earlier run in --out count as ~0)"]
         if "equal_error" in s:
             md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
                    s["equal_error"].rstrip(), "```"]
@@ -249,7 +249,7 @@ def main():
         os.makedirs(sdir, exist_ok=True)
         times = {}
         stage_t0 = scene_t0 = time.time()
-        stages = {}  # wall seconds per stage of this run (reused results cost ~0)
+        stages = {}  # wall seconds per stage of this run (results reused from --out cost ~0)
         for name, (terms, extra, refine, lr) in FITS.items():
             fit_dir = os.path.join(sdir, "fit_" + name)
             cmd = [a.bin, "fit", scene_file, "--encode", "--encode-res", f"{image_res}x{image_res}", "--ref-spp", str(ref_spp),
