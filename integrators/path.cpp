@@ -252,10 +252,12 @@ private:
                 continue;
             }
             const LightSample ls = ws.lights.get(k);
-            // A light sample behind the light or below the viewer's side of the surface is an
-            // attached shadow: V = 0 without tracing.
+            // A light sample behind the light, or below the viewer's side of a surface that only
+            // reflects, is an attached shadow: V = 0 without tracing. A transmissive surface
+            // (rough dielectric) sees lights on both sides.
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
-            if (!ls.valid() || sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f) {
+            const bool reflects_only = !(m_spectra.bsdf_of(m_scene, sq.shape[k]).flags() & kTransmission);
+            if (!ls.valid() || (reflects_only && sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f)) {
                 if (first && gate_shadowed) p.occlusion[slot] += occl;
                 if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
