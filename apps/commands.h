@@ -119,6 +119,21 @@ int run_viz(const VaeArgs& args);
 struct MetricsArgs { std::string a, b, vae_dir; bool json = false; };
 int run_metrics(const MetricsArgs&);
 
+/// `latentpt compare`: bias of renders against an independent reference beyond their noise.
+struct CompareArgs {
+    std::vector<std::string> test, ref;  ///< >= 2 renders per side (independent seeds) estimate its noise
+    std::string scene;                   ///< optional: masks directly seen emitters
+    std::map<std::string, std::string> defines;
+    int block = 32;
+    double sigma = 3.0;                  ///< a block beyond this many σ of its noise is flagged
+    double mean_tolerance = 0.005;       ///< verdict: channel means within this relative difference
+    double ratio_range = 0.1;            ///< ratio map saturates at 1 ± this
+    float exposure = 0.f;
+    std::string out_dir;
+    bool strict = false;                 ///< exit 3 when the verdict fails
+};
+int run_compare(const CompareArgs& a);
+
 /// ../shared (LATENTPT_SHARED overrides) + "/models/taesd3" unless `dir` is given.
 std::string default_vae_dir(const std::string& dir);
 /// ../shared (LATENTPT_SHARED overrides) + "/models/lpips" unless `dir` is given.

@@ -143,6 +143,25 @@ int main(int argc, char** argv) {
     metrics->add_option("--lpips-dir", m.vae_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
     metrics->add_flag("--json", m.json, "print one JSON object instead of text");
 
+    CompareArgs cmp;
+    std::vector<std::string> cmp_defines;
+    auto* compare = app.add_subcommand("compare", "bias of a render against an independent reference, beyond both renders' noise: "
+                                                  "channel mean ratios, block ratios with per-block noise, emitter-masked relMSE, "
+                                                  "pictures (docs/validation.md)");
+    compare->add_option("--test", cmp.test, "render(s) under test: give >= 2 with independent seeds to estimate their noise")
+        ->required()->check(CLI::ExistingFile);
+    compare->add_option("--ref", cmp.ref, "reference render(s), same size or an integer multiple (box-averaged down)")
+        ->required()->check(CLI::ExistingFile);
+    compare->add_option("--scene", cmp.scene, "scene of the renders: pixels that see an emitter directly are left out")->check(CLI::ExistingFile);
+    compare->add_option("-D,--define", cmp_defines, "scene override, as for render");
+    compare->add_option("--block", cmp.block, "block side in pixels")->capture_default_str()->check(CLI::PositiveNumber);
+    compare->add_option("--sigma", cmp.sigma, "flag blocks whose ratio is this many standard deviations of its noise from 1")->capture_default_str();
+    compare->add_option("--mean-tolerance", cmp.mean_tolerance, "verdict: channel means within this relative difference")->capture_default_str();
+    compare->add_option("--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this")->capture_default_str();
+    compare->add_option("--exposure", cmp.exposure, "exposure of the side-by-side previews in stops")->capture_default_str();
+    compare->add_option("-o,--out-dir", cmp.out_dir, "write comparison.txt/.json, ratio_map.png, side_by_side.png here");
+    compare->add_flag("--strict", cmp.strict, "exit with code 3 when the verdict is FAIL");
+
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
@@ -161,6 +180,14 @@ int main(int argc, char** argv) {
         if (*decode) return run_decode(v);
         if (*viz) return run_viz(v);
         if (*metrics) return run_metrics(m);
+        if (*compare) {
+            for (const auto& d : cmp_defines) {
+                auto eq = d.find('=');
+                if (eq == std::string::npos) throw std::invalid_argument("-D expects key=value, got '" + d + "'");
+                cmp.defines[d.substr(0, eq)] = d.substr(eq + 1);
+            }
+            return run_compare(cmp);
+        }
         if (*refine) return run_refine(rf);
         if (*fit) {
             for (const auto& d : fit_defines) {
