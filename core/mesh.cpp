@@ -94,6 +94,32 @@ void validate_mesh(TriangleMesh& mesh, const std::string& file, const std::strin
                                        : "mesh has no triangles");
 }
 
+void compute_vertex_normals(TriangleMesh& mesh) {
+    const size_t nt = mesh.triangle_count();
+    std::vector<Vec3f> sum(mesh.positions.size(), Vec3f::Zero());
+    std::vector<Vec3f> face(nt);
+    for (size_t t = 0; t < nt; ++t) {
+        const uint32_t* idx = &mesh.indices[3 * t];
+        const Vec3f p[3] = {mesh.positions[idx[0]], mesh.positions[idx[1]], mesh.positions[idx[2]]};
+        face[t] = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+        for (int k = 0; k < 3; ++k) {
+            const Vec3f a = (p[(k + 1) % 3] - p[k]).normalized(), b = (p[(k + 2) % 3] - p[k]).normalized();
+            // atan2 of |a x b| and a.b: accurate for small and large angles alike.
+            sum[idx[k]] += std::atan2(a.cross(b).norm(), a.dot(b)) * face[t];
+        }
+    }
+    bool planar = true;
+    for (size_t t = 0; t < nt && planar; ++t)
+        for (int k = 0; k < 3; ++k) planar = planar && sum[mesh.indices[3 * t + k]].normalized().dot(face[t]) > 1.f - 1e-6f;
+    if (planar) return;
+    mesh.normals.resize(sum.size());
+    for (size_t v = 0; v < sum.size(); ++v) {
+        const float len = sum[v].norm();
+        // A vertex no triangle uses keeps an arbitrary unit normal: nothing interpolates it.
+        mesh.normals[v] = len > 0.f ? Vec3f(sum[v] / len) : Vec3f::UnitZ();
+    }
+}
+
 TriangleMesh load_mesh_file(const std::string& path, bool flip_v, bool drop_degenerate) {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });

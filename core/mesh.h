@@ -24,6 +24,15 @@ struct TriangleMesh {
 /// NaN and range errors always fail.
 void validate_mesh(TriangleMesh& mesh, const std::string& file, const std::string& field, bool drop_degenerate = false);
 
+/// Smooth vertex normals for a mesh that has none, as Mitsuba 3 computes them when an obj/ply
+/// file stores no normals and face_normals is off: each triangle adds its unit normal times its
+/// interior angle at the vertex (Thürmer & Wüthrich 1998). Call after the world transform (the
+/// angles are world-space angles, as Mitsuba's). Where every vertex normal would equal the normals
+/// of all triangles around it (a piecewise planar mesh: walls, quads), the normals stay empty:
+/// flat shading is then the same surface and keeps the flat fast paths. Zero-area triangles
+/// must be gone (validate_mesh).
+void compute_vertex_normals(TriangleMesh& mesh);
+
 /// Readers. Each throws SceneError naming `path` on missing file / parse error; they validate.
 /// OBJ: v, vt, vn, faces with v, v/vt, v//vn, v/vt/vn; polygons fan-triangulated. Mitsuba
 /// flips the v texture coordinate on load (`flip_tex_coords`): pass flip_v=true for its scenes.

@@ -465,6 +465,8 @@ private:
         } catch (const SceneError& e) {
             rethrow_at(src, e, p.line);
         }
+        // A mesh file without normals is smooth-shaded in Mitsuba 3 unless face_normals is set.
+        if ((t == "obj" || t == "ply") && !shape.face_normals && shape.mesh.normals.empty()) compute_vertex_normals(shape.mesh);
 
         const int index = int(scene.shapes.size());
         for (const pugi::xml_node& c : p.children) {
