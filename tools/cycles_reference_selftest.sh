@@ -44,7 +44,9 @@ if [ "$keep" = 0 ]; then trap 'rm -rf "$tmp"' EXIT; else echo "keeping $tmp"; fi
 fail=0
 blender_py() {  # blender_py SCRIPT ARGS...: run a Python file inside Blender
     local py="$1"; shift
-    blender -b --factory-startup --python "$py" -- "$@"
+    # Blender's embedded Python takes its prefix from the first python3 on PATH: put Blender's own
+    # folder first so a pyenv/virtualenv python3 does not hide the system numpy from it.
+    PATH="$(dirname "$(readlink -f "$(command -v blender)")"):$PATH" blender -b --factory-startup --python "$py" -- "$@"
 }
 render() {  # render NAME XML ARGS...
     local name="$1" xml="$2"; shift 2

@@ -1,0 +1,194 @@
+#!/usr/bin/env python3
+"""latentpt's RGB path tracer against an independent renderer (Blender Cycles) on the paper's
+scenes: docs/validation.md. Python standard library only; drives the latentpt binary, Blender
+(Debian's `blender`, installed on demand: `apt-get install blender`; validation only) through
+tools/cycles_reference.py, and `latentpt compare`.
+
+For each scene, both renderers render it twice with independent seeds at half the sample count
+each (the two halves give each side's noise), then `latentpt compare` reports channel-mean
+ratios, 32x32 block ratios against their noise, emitter-masked relMSE and pictures:
+
+    <out>/<scene>/ours_{1,2}.exr, cycles_{1,2}.exr (+ .json: Cycles' settings and approximations)
+    <out>/<scene>/compare/    comparison.txt/.json, side_by_side.png, ratio_map.png
+    <out>/summary.md, summary.json
+
+Finished renders are reused when rerun with the same settings (resumable); --force redoes them.
+Without Blender the Cycles side is skipped and the summary says so.
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+# name -> scene file under <shared>/scenes
+SCENES = {
+    "cornell-box": "cornell-box/scene_v3.xml",
+    "cbox-specular": "cbox/cbox_specular.xml",
+    "veach-bidir": "veach-bidir/scene_v3.xml",
+    "dining-room": "dining-room/scene_diffuse.xml",
+    "classroom": "classroom/scene_constant.xml",
+}
+
+
+def shared_dir():
+    return os.environ.get("LATENTPT_SHARED", os.path.join(ROOT, "..", "shared"))
+
+
+def run(cmd, log, env=None):
+    """Runs cmd, appends its output to log, returns seconds; raises with the log's tail on failure."""
+    start = time.time()
+    with open(log, "a") as f:
+        f.write("$ " + " ".join(cmd) + "\n")
+        f.flush()
+        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, env=env)
+    if r.returncode != 0:
+        with open(log) as f:
+            tail = f.read()[-3000:]
+        raise RuntimeError("command failed (exit %d): %s\n%s" % (r.returncode, " ".join(cmd), tail))
+    return time.time() - start
+
+
+def blender_env(blender):
+    """Environment for Blender: its embedded Python takes its prefix from the first python3 on PATH, so
+    Blender's own folder goes first (a pyenv or virtualenv python3 would hide the system numpy)."""
+    env = dict(os.environ)
+    exe = shutil.which(blender)
+    if exe:
+        env["PATH"] = os.path.dirname(os.path.realpath(exe)) + os.pathsep + env.get("PATH", "")
+    for k in ("PYTHONHOME", "PYTHONPATH"):
+        env.pop(k, None)
+    return env
+
+
+def render_once(kind, args, scene_path, out_exr, seed, extra, log):
+    """Renders unless out_exr exists with the same settings (kept in out_exr + '.settings')."""
+    settings = {"kind": kind, "scene": scene_path, "res": args.res, "spp": args.spp // 2, "seed": seed, "extra": extra}
+    stamp = out_exr + ".settings"
+    if not args.force and os.path.exists(out_exr) and os.path.exists(stamp):
+        with open(stamp) as f:
+            old = json.load(f)
+        if {k: v for k, v in old.items() if k != "seconds"} == settings:
+            return old.get("seconds", 0.0), True
+    res = "%dx%d" % (args.res, args.res)
+    if kind == "ours":
+        cmd = [args.bin, "--threads", str(args.threads), "render", scene_path, "--res", res, "--spp", str(args.spp // 2),
+               "--seed", str(seed), "-q", "--out", out_exr] + extra
+    else:
+        cmd = [args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+               os.path.join(ROOT, "tools", "cycles_reference.py"), "--", scene_path, "--res", res, "--spp",
+               str(args.spp // 2), "--seed", str(seed), "--threads", str(args.threads), "--out", out_exr] + extra
+    seconds = run(cmd, log, blender_env(args.blender) if kind == "cycles" else None)
+    settings["seconds"] = seconds
+    tmp = stamp + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(settings, f)
+    os.replace(tmp, stamp)
+    return seconds, False
+
+
+def approximations(cycles_exr):
+    try:
+        with open(cycles_exr + ".json") as f:
+            return json.load(f).get("approximations", [])
+    except (OSError, ValueError):
+        return []
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated, from: " + ", ".join(SCENES))
+    ap.add_argument("--res", type=int, default=256, help="square image resolution")
+    ap.add_argument("--spp", type=int, default=1024, help="samples per pixel per renderer (two renders of spp/2)")
+    ap.add_argument("--threads", type=int, default=os.cpu_count() or 2)
+    ap.add_argument("--out", default=os.path.join(ROOT, "validation-out"))
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "apps", "latentpt"))
+    ap.add_argument("--blender", default="blender")
+    ap.add_argument("--force", action="store_true", help="re-render even where finished renders exist")
+    ap.add_argument("-D", dest="defines", action="append", default=[], help="scene override for both renderers, e.g. max_depth=6")
+    args = ap.parse_args()
+
+    have_blender = shutil.which(args.blender) is not None
+    if not have_blender:
+        print("validate: no Blender (%s) found: the Cycles side is skipped (install: apt-get install blender)" % args.blender)
+    extra = []
+    for d in args.defines:
+        extra += ["-D", d]
+    os.makedirs(args.out, exist_ok=True)
+    summary = []
+    for name in [s for s in args.scenes.split(",") if s]:
+        if name not in SCENES:
+            sys.exit("validate: unknown scene '%s' (known: %s)" % (name, ", ".join(SCENES)))
+        scene_path = os.path.join(shared_dir(), "scenes", SCENES[name])
+        if not os.path.exists(scene_path):
+            sys.exit("validate: %s not found (set LATENTPT_SHARED)" % scene_path)
+        folder = os.path.join(args.out, name)
+        os.makedirs(folder, exist_ok=True)
+        log = os.path.join(folder, "log.txt")
+        entry = {"scene": name, "file": SCENES[name], "res": args.res, "spp": args.spp, "defines": args.defines}
+        t_ours = 0.0
+        for seed in (1, 2):
+            s, reused = render_once("ours", args, scene_path, os.path.join(folder, "ours_%d.exr" % seed), seed, extra, log)
+            t_ours += s
+            print("validate: %s ours seed %d: %s" % (name, seed, "reused" if reused else "%.1f s" % s), flush=True)
+        entry["seconds_ours"] = t_ours
+        if have_blender:
+            t_cycles = 0.0
+            for seed in (1, 2):
+                s, reused = render_once("cycles", args, scene_path, os.path.join(folder, "cycles_%d.exr" % seed), seed, extra, log)
+                t_cycles += s
+                print("validate: %s cycles seed %d: %s" % (name, seed, "reused" if reused else "%.1f s" % s), flush=True)
+            entry["seconds_cycles"] = t_cycles
+            entry["approximations"] = approximations(os.path.join(folder, "cycles_1.exr"))
+            cmp_dir = os.path.join(folder, "compare")
+            cmd = [args.bin, "compare", "--test", os.path.join(folder, "ours_1.exr"), os.path.join(folder, "ours_2.exr"),
+                   "--ref", os.path.join(folder, "cycles_1.exr"), os.path.join(folder, "cycles_2.exr"),
+                   "--scene", scene_path, "-o", cmp_dir] + extra
+            run(cmd, log)
+            with open(os.path.join(cmp_dir, "comparison.json")) as f:
+                c = json.load(f)
+            with open(os.path.join(cmp_dir, "comparison.txt")) as f:
+                print(f.read(), flush=True)
+            blocks = [b for b in c["blocks"] if b["pixels"] > 0]
+            entry.update({
+                "mean_ratio": c["mean_ratio"], "mean_ratio_sigma": c["mean_ratio_sigma"], "rel_mse": c["rel_mse"],
+                "blocks": len(blocks), "blocks_flagged": c["blocks_flagged"],
+                "blocks_brighter": sum(1 for b in blocks if b["ratio"] > 1.0),
+                "max_abs_z": max(abs(b["z"]) for b in blocks) if blocks else 0.0,
+            })
+        summary.append(entry)
+        write_summary(args.out, summary, have_blender)
+    print("validate: wrote %s" % os.path.join(args.out, "summary.md"))
+
+
+def write_summary(out, summary, have_blender):
+    lines = ["| scene | ours / Cycles mean R | G | B | relMSE (emitters masked) | 32² blocks beyond 3σ | max abs(z) | "
+             "blocks brighter | time ours / Cycles |", "|---|---|---|---|---|---|---|---|---|"]
+    for e in summary:
+        if "mean_ratio" not in e:
+            lines.append("| %s | – | – | – | – | – | – | – | %.0f s / (no Blender) |" % (e["scene"], e["seconds_ours"]))
+            continue
+        r, s = e["mean_ratio"], e["mean_ratio_sigma"]
+        lines.append("| %s | %.4f ± %.4f | %.4f ± %.4f | %.4f ± %.4f | %.5f | %d of %d | %.1f | %d | %.0f s / %.0f s |" % (
+            e["scene"], r[0], s[0], r[1], s[1], r[2], s[2], e["rel_mse"], e["blocks_flagged"], e["blocks"], e["max_abs_z"],
+            e["blocks_brighter"], e["seconds_ours"], e["seconds_cycles"]))
+    text = "\n".join(lines) + "\n"
+    if not have_blender:
+        text += "\nNo Blender on this machine: only our renders were made.\n"
+    for e in summary:
+        if e.get("approximations"):
+            text += "\n%s, Cycles approximations:\n" % e["scene"] + "".join("- %s\n" % a for a in e["approximations"])
+    for name, content in (("summary.md", text), ("summary.json", json.dumps(summary, indent=1) + "\n")):
+        tmp = os.path.join(out, name + ".tmp")
+        with open(tmp, "w") as f:
+            f.write(content)
+        os.replace(tmp, os.path.join(out, name))
+
+
+if __name__ == "__main__":
+    main()
