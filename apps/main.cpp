@@ -1,5 +1,6 @@
 // latentpt command line: `latentpt <subcommand> --help` describes each subcommand.
 #include "apps/commands.h"
+#include "integrators/path.h"
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 #include <iostream>
@@ -11,6 +12,10 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     int threads = 0;
     app.add_option("--threads", threads, "worker threads (default: all cores)");
+    std::string sampler;
+    app.add_option("--sampler", sampler, "random numbers of every render: sobol (Owen-scrambled, low discrepancy) or independent "
+                                         "(default: the scene's; docs/sampling.md)")
+        ->check(CLI::IsMember({"sobol", "independent"}));
 
     RenderArgs r;
     std::vector<std::string> defines;
@@ -165,6 +170,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+    if (!sampler.empty()) lpt::set_sampler_override(sampler == "sobol" ? lpt::SamplerKind::Sobol : lpt::SamplerKind::Independent);
     try {
         if (*render) {
             for (const auto& d : defines) {

@@ -42,7 +42,7 @@ int run_render(const RenderArgs& a) {
     if (a.aov) {
         int aw = img.width, ah = img.height;
         if (!a.aov_res.empty()) parse_resolution(a.aov_res, aw, ah);
-        AovImages aov = render_aovs(scene, spectra, aw, ah, std::min(opt.spp, 16), a.seed);
+        AovImages aov = render_aovs(scene, spectra, aw, ah, std::min(opt.spp, 16), a.seed, opt.sampler);
         write_exr(with_suffix(a.out, ".normal.exr"), Image{aov.width, aov.height, 3, aov.normal, {"X", "Y", "Z"}});
         write_exr(with_suffix(a.out, ".distance.exr"), Image{aov.width, aov.height, 1, aov.distance, {"Z"}});
         write_exr(with_suffix(a.out, ".albedo.exr"), Image{aov.width, aov.height, 3, aov.albedo, {"R", "G", "B"}});

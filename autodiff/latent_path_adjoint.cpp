@@ -13,7 +13,7 @@ namespace {
 class Adjoint final : public detail::PathRecorder {
 public:
     Adjoint(const LatentModel& model, const RenderOptions& opt, const std::vector<float>& d_image, int n_tiles)
-        : PathRecorder(n_tiles), m_model(model), m_seed(opt.seed), m_d_image(d_image), m_inv_spp(1.f / float(opt.spp)), m_tile_grads(n_tiles) {}
+        : PathRecorder(n_tiles), m_model(model), m_sampler{opt.seed, opt.sampler}, m_d_image(d_image), m_inv_spp(1.f / float(opt.spp)), m_tile_grads(n_tiles) {}
 
     /// Sums the per-tile buffers in tile order into `out` (deterministic).
     void reduce(std::vector<float>& out) const {
@@ -26,12 +26,12 @@ protected:
         // One task owns a tile: its buffer is never shared between threads.
         std::vector<float>& g = m_tile_grads[tile];
         if (g.empty()) g.assign(m_model.params().values().size(), 0.f);
-        detail::backward_block(m_model, m_seed, block, m_d_image.data(), m_inv_spp, g.data());
+        detail::backward_block(m_model, m_sampler, block, m_d_image.data(), m_inv_spp, g.data());
     }
 
 private:
     const LatentModel& m_model;
-    uint64_t m_seed;
+    SamplerId m_sampler;
     const std::vector<float>& m_d_image;
     float m_inv_spp;
     std::vector<std::vector<float>> m_tile_grads;

@@ -146,9 +146,9 @@ BSDFSample<kLatentChannels> sample_of(const PathEvent& e) {
 /// f·|cos|/p with the recorded direction and pdf. Delta lobes have no density to divide by, so
 /// the BSDF samples again with the path's own random numbers: its lobe choice and direction
 /// depend on geometry only (core/bsdf.h), so it returns the recorded lobe with today's value.
-L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, uint64_t seed, uint32_t pixel, uint32_t sample) {
+L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, SamplerId sampler, uint32_t pixel, uint32_t sample) {
     if (e.lobe & kDelta) {
-        const BsdfRandoms u = bsdf_randoms(SampleStream{seed, pixel, sample}, e.depth);
+        const BsdfRandoms u = bsdf_randoms(sampler.stream(pixel, sample), e.depth);
         BSDFSample<kLatentChannels> bs = bsdf.sample(context_of(e), e.wi, u.lobe, Vec2f(u.dir[0], u.dir[1]));
         return bs.lobe == e.lobe ? L(bs.weight) : L::Zero();
     }
@@ -157,7 +157,7 @@ L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, uint64_t 
 
 /// Throughput in front of each event (beta) and each event's local factor (local): visible NEE
 /// f·w/p, bounce weight/q. docs/path-replay.md (1).
-void sweep_forward(const LatentModel& m, uint64_t seed, uint32_t pixel, uint32_t sample, const PathEvent* ev, size_t n, PathScratch& s) {
+void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint32_t sample, const PathEvent* ev, size_t n, PathScratch& s) {
     if (s.beta.size() < n) {
         s.beta.resize(n);
         s.local.resize(n);
@@ -169,7 +169,7 @@ void sweep_forward(const LatentModel& m, uint64_t seed, uint32_t pixel, uint32_t
         if (e.type == PathEvent::Light && (e.flags & PathEvent::kNee) && (e.flags & PathEvent::kVisible)) {
             s.local[i] = m.spectra().bsdf_of(m.scene(), e.shape).eval(context_of(e), e.wi, e.wo) * e.scalar;
         } else if (e.type == PathEvent::Bounce) {
-            s.local[i] = bounce_weight(m.spectra().bsdf_of(m.scene(), e.shape), e, seed, pixel, sample) / e.scalar;
+            s.local[i] = bounce_weight(m.spectra().bsdf_of(m.scene(), e.shape), e, sampler, pixel, sample) / e.scalar;
             beta *= s.local[i];
         }
     }
@@ -194,7 +194,7 @@ PathScratch& path_scratch() {
 
 }  // namespace
 
-void backward_block(const LatentModel& m, uint64_t seed, const PathBlock& block, const float* d_image, float inv_spp, float* g) {
+void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& block, const float* d_image, float inv_spp, float* g) {
     const ParamStore& ps = m.params();
     const auto& terms = m.terms();
     const auto& radiance = m.spectra().radiance;
@@ -206,7 +206,7 @@ void backward_block(const LatentModel& m, uint64_t seed, const PathBlock& block,
         const PathEvent* ev = block.events.data() + block.begin[k];
         const size_t n = block.begin[k + 1] - block.begin[k];
         if (n == 0) continue;
-        sweep_forward(m, seed, block.pixel[k], block.sample[k], ev, n, s);
+        sweep_forward(m, sampler, block.pixel[k], block.sample[k], ev, n, s);
         const L d = Eigen::Map<const L>(d_image + size_t(block.pixel[k]) * kLatentChannels) * inv_spp;
         // A scalar parameter (roughness) scales every channel: its derivative sums them.
         auto add_scalar = [&](int shape, const L& v) {
@@ -264,7 +264,7 @@ void backward_block(const LatentModel& m, uint64_t seed, const PathBlock& block,
 PathRecords record_latent_paths(const LatentModel& model, const RenderOptions& opt, std::vector<float>* image, RenderStats* stats) {
     const Scene& scene = model.scene();
     PathRecords r;
-    r.seed = opt.seed;
+    r.sampler = {opt.seed, opt.sampler};
     r.width = opt.width > 0 ? opt.width : scene.camera.width;
     r.height = opt.height > 0 ? opt.height : scene.camera.height;
     r.spp = opt.spp;
@@ -288,7 +288,7 @@ std::vector<float> replay_forward(const LatentModel& m, const PathRecords& r) {
                 const PathEvent* ev = block.events.data() + block.begin[k];
                 const size_t n = block.begin[k + 1] - block.begin[k];
                 L e_sum = L::Zero(), a_sum = L::Zero(), c_sum = L::Zero();
-                detail::sweep_forward(m, r.seed, block.pixel[k], block.sample[k], ev, n, s);
+                detail::sweep_forward(m, r.sampler, block.pixel[k], block.sample[k], ev, n, s);
                 for (size_t i = 0; i < n; ++i) {
                     const PathEvent& e = ev[i];
                     const L& beta = s.beta[i];
@@ -319,7 +319,7 @@ void replay_backward(LatentModel& m, const PathRecords& r, const std::vector<flo
     tbb::parallel_for(0, int(r.tiles.size()), [&](int t) {
         if (r.tiles[t].empty()) return;
         tile_grads[t].assign(n_values, 0.f);
-        for (const PathBlock& block : r.tiles[t]) detail::backward_block(m, r.seed, block, d_image.data(), 1.f / float(r.spp), tile_grads[t].data());
+        for (const PathBlock& block : r.tiles[t]) detail::backward_block(m, r.sampler, block, d_image.data(), 1.f / float(r.spp), tile_grads[t].data());
     });
     // Summed in tile order: bit-identical at any thread count (docs/path-replay.md (5)).
     std::vector<float>& out = m.params().grad_values();

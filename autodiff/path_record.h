@@ -39,7 +39,7 @@ struct PathBlock {
 
 /// Every path of one primal render (a fit iteration's seed, spp and resolution).
 struct PathRecords {
-    uint64_t seed = 0;
+    SamplerId sampler;  ///< the primal's seed and sampler kind
     int width = 0, height = 0, spp = 0;
     std::vector<std::vector<PathBlock>> tiles;  ///< per image tile, wavefronts in trace order
     size_t events() const;
@@ -88,7 +88,7 @@ private:
 };
 
 /// Gradient sweep of one block: adds into `grad` (the ParamStore's value layout).
-void backward_block(const LatentModel& model, uint64_t seed, const PathBlock& block, const float* d_image, float inv_spp, float* grad);
+void backward_block(const LatentModel& model, SamplerId sampler, const PathBlock& block, const float* d_image, float inv_spp, float* grad);
 
 }  // namespace detail
 

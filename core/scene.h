@@ -7,6 +7,7 @@
 #include "core/emitter.h"
 #include "core/light_sampler.h"
 #include "core/props.h"
+#include "core/sampler.h"
 #include "core/shape.h"
 #include <embree3/rtcore.h>
 #include <string>
@@ -18,6 +19,7 @@ struct IntegratorSettings {
     int max_depth = 8;   ///< longest path in segments, Mitsuba's semantics; -1 = unbounded
     int rr_depth = 5;    ///< Russian roulette from this depth on
     int spp = 16;        ///< default samples per pixel
+    SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
     LightSampling light_sampling = LightSampling::Power;
 };
 

@@ -4,7 +4,7 @@
 
 namespace lpt {
 
-AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed) {
+AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed, SamplerKind sampler) {
     Camera camera = scene.camera.with_resolution(width, height);
     AovImages out;
     out.width = width;
@@ -19,7 +19,7 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
             Vec3f n_sum = Vec3f::Zero(), a_sum = Vec3f::Zero();
             float d_sum = 0.f;
             for (int s = 0; s < spp; ++s) {
-                SampleStream rng{seed, pixel, uint32_t(s)};
+                SampleStream rng{seed, pixel, uint32_t(s), sampler};
                 Vec2f off = camera.filter.sample(Vec2f(rng.get(dim::kFilter), rng.get(dim::kFilter + 1)));
                 Ray r = camera.generate_ray(Vec2f(x + 0.5f + off.x(), y + 0.5f + off.y()));
                 SurfaceInteraction si = scene.intersect(r);

@@ -15,6 +15,7 @@ struct AovImages {
     std::vector<float> albedo;    ///< 3 per pixel
 };
 
-AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed);
+AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed,
+                      SamplerKind sampler = SamplerKind::Sobol);
 
 }  // namespace lpt

@@ -16,11 +16,22 @@
 
 namespace lpt {
 
+namespace {
+bool g_sampler_overridden = false;
+SamplerKind g_sampler_override = SamplerKind::Sobol;
+}  // namespace
+
+void set_sampler_override(SamplerKind kind) {
+    g_sampler_overridden = true;
+    g_sampler_override = kind;
+}
+
 RenderOptions RenderOptions::from_scene(const Scene& scene) {
     RenderOptions o;
     o.spp = scene.integrator.spp;
     o.max_depth = scene.integrator.max_depth;
     o.rr_depth = scene.integrator.rr_depth;
+    o.sampler = g_sampler_overridden ? g_sampler_override : scene.integrator.sampler;
     return o;
 }
 
@@ -99,7 +110,7 @@ private:
             int x = x0 + local % w, y = y0 + local / w;
             p.pixel[k] = uint32_t(y * m_camera.width + x);
             p.sample[k] = uint32_t(s0 + int(k) % count);
-            const SampleStream rng{m_opt.seed, p.pixel[k], p.sample[k]};
+            const SampleStream rng{m_opt.seed, p.pixel[k], p.sample[k], m_opt.sampler};
             p.key[k] = rng.key;
             fx[k] = float(x);
             fy[k] = float(y);
@@ -230,7 +241,7 @@ private:
             LightBatch& lb = ws.lights;
             lb.resize(sq.size());
             for (size_t k = 0; k < sq.size(); ++k) {
-                const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]]);
+                const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler);
                 lb.rx[k] = sq.p[k].x(); lb.ry[k] = sq.p[k].y(); lb.rz[k] = sq.p[k].z();
                 lb.u_choice[k] = rng.get(dim::bounce(depth, dim::kLightChoice));
                 lb.u_pos0[k] = rng.get(dim::bounce(depth, dim::kLightPos));
@@ -312,7 +323,7 @@ private:
         for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0], &ws.cosine[1], &ws.cosine[2]})
             if (a->size() < n) a->resize(n);
         for (size_t k = 0; k < n; ++k) {
-            const BsdfRandoms u = bsdf_randoms(SampleStream::from_key(p.key[sq.slot[k]]), uint32_t(depth));
+            const BsdfRandoms u = bsdf_randoms(SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler), uint32_t(depth));
             ws.u_lobe[k] = u.lobe;
             ws.u_dir[0][k] = u.dir[0];
             ws.u_dir[1][k] = u.dir[1];
@@ -322,7 +333,7 @@ private:
             if (!(sq.flags[k] & ShadeQueue::kContinue)) continue;
             const uint32_t slot = sq.slot[k];
             const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
-            const SampleStream rng = SampleStream::from_key(p.key[slot]);
+            const SampleStream rng = SampleStream::from_key(p.key[slot], p.sample[slot], m_opt.sampler);
             BSDFContext ctx;
             ctx.uv = sq.uv[k];
             const Lambertian lambertian = m_lambertian[sq.shape[k]];

@@ -4,6 +4,7 @@
 // and per-tile ownership of pixels make it independent of the thread count.
 #pragma once
 #include "core/film.h"
+#include "core/sampler.h"
 #include "core/scene.h"
 #include "core/scene_spectra.h"
 #include "integrators/path_observer.h"
@@ -11,6 +12,10 @@
 #include <functional>
 
 namespace lpt {
+
+/// A process-wide sampler choice that overrides every scene's (the CLI's `--sampler`); tests and
+/// library users leave it unset and set RenderOptions::sampler instead.
+void set_sampler_override(SamplerKind kind);
 
 /// Which estimator collects light: both combined (MIS), or one alone (for tests/debugging).
 enum class LightStrategy { Mis, Nee, Bsdf };
@@ -22,8 +27,11 @@ struct RenderOptions {
     int max_depth = 8;           ///< Mitsuba semantics: 1 = emitters seen directly; -1 = unbounded
     int rr_depth = 5;
     LightStrategy strategy = LightStrategy::Mis;
+    SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
     /// Called now and then with (fraction done, rays traced so far); from a worker thread.
     std::function<void(double, uint64_t)> progress;
+    /// The scene's settings; the sampler is the command line's `--sampler` where one was given
+    /// (set_sampler_override), else the scene's.
     static RenderOptions from_scene(const Scene& scene);
 };
 

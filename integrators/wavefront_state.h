@@ -44,7 +44,7 @@ struct PathState {
     AlignedVector<Spectrum<N>> beta;       ///< throughput (signed for latents)
     AlignedVector<Spectrum<N>> radiance;   ///< accumulated estimate
     std::vector<uint32_t> pixel, sample;   ///< film pixel and sample index
-    std::vector<uint64_t> key;             ///< sample_key(seed, pixel, sample), hashed once
+    std::vector<uint64_t> key;             ///< SampleStream key of (seed, pixel, sample), hashed once
     std::vector<float> prev_pdf;           ///< solid-angle pdf of the last BSDF sample (MIS)
     std::vector<uint8_t> prev_delta;       ///< last scattering was a delta lobe (or camera)
     AlignedVector<Vec3f> prev_p;           ///< last vertex position (area-light pdf on hits)

@@ -163,6 +163,10 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
         if (auto* v = c.opt(*ij, "rr_depth")) s.rr_depth = c.integer(*v, "integrator.rr_depth");
         if (auto* v = c.opt(*ij, "spp")) s.spp = c.integer(*v, "integrator.spp");
         if (s.spp < 1) c.fail("integrator.spp", "must be >= 1");
+        if (auto* v = c.opt(*ij, "sampler")) {
+            std::string m = c.string(*v, "integrator.sampler");
+            if (!parse_sampler(m, s.sampler)) c.fail("integrator.sampler", "expected sobol or independent, got '" + m + "'");
+        }
         if (auto* v = c.opt(*ij, "light_sampling")) {
             std::string m = c.string(*v, "integrator.light_sampling");
             if (m == "power") s.light_sampling = LightSampling::Power;

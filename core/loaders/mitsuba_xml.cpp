@@ -364,10 +364,14 @@ private:
 
     void read_sampler(const pugi::xml_node& n) {
         Plugin p = read_plugin(n, "sampler");
-        // Only the sample count is taken: we always draw from our own sampler, so the Mitsuba
-        // sampler type (and its seed/jitter) changes noise, not the expected image.
-        if (p.type != "independent" && p.type != "multijitter" && p.type != "stratified") unknown_plugin(p, "independent, multijitter, stratified");
-        allow_only(p, {"sample_count", "seed", "jitter"});
+        // The sample count, and the nearest sampler we have (docs/sampling.md): `independent` stays
+        // independent, every stratified or low-discrepancy Mitsuba sampler becomes Owen-scrambled
+        // Sobol. Its seed, jitter and strength change noise, not the expected image.
+        if (p.type == "independent") scene.integrator.sampler = SamplerKind::Independent;
+        else if (p.type == "stratified" || p.type == "multijitter" || p.type == "ldsampler" || p.type == "orthogonal")
+            scene.integrator.sampler = SamplerKind::Sobol;
+        else unknown_plugin(p, "independent, stratified, multijitter, ldsampler, orthogonal");
+        allow_only(p, {"sample_count", "seed", "jitter", "strength"});
         for (const pugi::xml_node& c : p.children) unexpected_child(p, c);
         long long spp = get_int(p, "sample_count", 4);
         if (spp < 1) fail_value(p, "sample_count", "must be >= 1");

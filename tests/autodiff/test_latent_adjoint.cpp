@@ -202,7 +202,7 @@ TEST(LatentAdjoint, RoughnessGradientMatchesFiniteDifferencesInExpectation) {
     for (uint64_t seed = 0; seed < 24; ++seed) {
         RenderOptions o = opts(scene);
         o.seed = 100 + seed;
-        o.spp = 16;
+        o.spp = 32;
         m.params().zero_grad();
         backward_latent(m, o, w);
         prb.push_back(m.params().grad_values()[m.params().slice(alpha).value_offset]);
