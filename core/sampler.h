@@ -133,7 +133,7 @@ private:
 /// What regenerates a render's random numbers: its seed and sampler kind (path replay keeps it).
 struct SamplerId {
     uint64_t seed = 0;
-    SamplerKind kind = SamplerKind::Sobol;
+    SamplerKind kind = SamplerKind::Independent;
     SampleStream stream(uint32_t pixel, uint32_t sample_index) const { return SampleStream(seed, pixel, sample_index, kind); }
 };
 
