@@ -131,19 +131,19 @@ def main():
         os.makedirs(folder, exist_ok=True)
         log = os.path.join(folder, "log.txt")
         entry = {"scene": name, "file": SCENES[name], "res": args.res, "spp": args.spp, "defines": args.defines}
-        t_ours = 0.0
-        for seed in (1, 2):
-            s, reused = render_once("ours", args, scene_path, os.path.join(folder, "ours_%d.exr" % seed), seed, extra, log)
-            t_ours += s
-            print("validate: %s ours seed %d: %s" % (name, seed, "reused" if reused else "%.1f s" % s), flush=True)
-        entry["seconds_ours"] = t_ours
-        if have_blender:
-            t_cycles = 0.0
+
+        def render_pair(kind):
+            """Both seeds of one renderer; returns their seconds."""
+            total = 0.0
             for seed in (1, 2):
-                s, reused = render_once("cycles", args, scene_path, os.path.join(folder, "cycles_%d.exr" % seed), seed, extra, log)
-                t_cycles += s
-                print("validate: %s cycles seed %d: %s" % (name, seed, "reused" if reused else "%.1f s" % s), flush=True)
-            entry["seconds_cycles"] = t_cycles
+                s, reused = render_once(kind, args, scene_path, os.path.join(folder, "%s_%d.exr" % (kind, seed)), seed, extra, log)
+                total += s
+                print("validate: %s %s seed %d: %s" % (name, kind, seed, "reused" if reused else "%.1f s" % s), flush=True)
+            return total
+
+        entry["seconds_ours"] = render_pair("ours")
+        if have_blender:
+            entry["seconds_cycles"] = render_pair("cycles")
             entry["approximations"] = approximations(os.path.join(folder, "cycles_1.exr"))
             cmp_dir = os.path.join(folder, "compare")
             cmd = [args.bin, "compare", "--test", os.path.join(folder, "ours_1.exr"), os.path.join(folder, "ours_2.exr"),
