@@ -170,7 +170,8 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-    if (!sampler.empty()) lpt::set_sampler_override(sampler == "sobol" ? lpt::SamplerKind::Sobol : lpt::SamplerKind::Independent);
+    lpt::SamplerKind sampler_kind;
+    if (lpt::parse_sampler(sampler, sampler_kind)) lpt::set_sampler_override(sampler_kind);  // empty: the scenes decide
     try {
         if (*render) {
             for (const auto& d : defines) {

@@ -48,37 +48,68 @@ inline float sample_1d(uint64_t seed, uint32_t pixel, uint32_t sample_index, uin
 // ---- Owen-scrambled Sobol (docs/sampling.md (8)-(10)) --------------------------------------
 
 inline uint32_t reverse_bits32(uint32_t x) {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = __builtin_bswap32(x);  // one instruction for the byte-level half of the reversal
     x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
     return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
 }
 
-/// Nested uniform (Owen) scramble of a 32-bit binary fraction: each bit is flipped by a hash of the
-/// seed and of the more significant bits only, so aligned dyadic intervals map onto aligned dyadic
-/// intervals. A Laine-Karras style hash on the bit-reversed value (a multiply by an even constant
-/// moves information only towards more significant bits); constants from Vegdahl's search for
-/// better-avalanching variants of Burley's (JCGT 2020) hash.
-inline uint32_t owen_scramble(uint32_t x, uint32_t seed) {
-    x = reverse_bits32(x);
+/// Laine-Karras style hash: bit t of the result depends on the seed and on bits <= t of x only (a
+/// multiply by an even constant moves information only towards more significant bits). Constants
+/// from Vegdahl's search for better-avalanching variants of Burley's (JCGT 2020) hash.
+inline uint32_t lk_hash(uint32_t x, uint32_t seed) {
     x ^= x * 0x3d20adeau;
     x += seed;
     x *= (seed >> 16) | 1u;
     x ^= x * 0x05526c56u;
     x ^= x * 0x53a22864u;
-    return reverse_bits32(x);
+    return x;
 }
+
+/// Nested uniform (Owen) scramble of a 32-bit binary fraction: each bit is flipped by a hash of the
+/// seed and of the more significant bits only, so aligned dyadic intervals map onto aligned dyadic
+/// intervals: lk_hash on the bit-reversed value.
+inline uint32_t owen_scramble(uint32_t x, uint32_t seed) { return reverse_bits32(lk_hash(reverse_bits32(x), seed)); }
 
 /// The first two dimensions of the Sobol sequence as 32-bit fractions: van der Corput (radix
 /// inverse), and the dimension of primitive polynomial x + 1 (direction v_k = v_{k-1} ^ v_{k-1} >> 1).
 inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits32(index); }
-inline uint32_t sobol_dimension1(uint32_t index) {
-    uint32_t x = 0;
-    for (uint32_t v = 1u << 31; index != 0; index >>= 1, v ^= v >> 1)
-        if (index & 1u) x ^= v;
-    return x;
+
+/// A linear map of 32 bits (over GF(2)) applied a byte at a time: entry [b][e] is the XOR of the
+/// images of the set bits of e placed at byte b. Four lookups instead of a 32-round bit loop (the
+/// shuffled index has all 32 bits in play).
+struct BitMatrixTable {
+    uint32_t t[4][256];
+    /// column(k): the image of bit k.
+    template <class Column>
+    constexpr explicit BitMatrixTable(Column column) : t{} {
+        for (int b = 0; b < 4; ++b)
+            for (int e = 0; e < 256; ++e) {
+                uint32_t x = 0;
+                for (int k = 0; k < 8; ++k)
+                    if (e >> k & 1) x ^= column(8 * b + k);
+                t[b][e] = x;
+            }
+    }
+    constexpr uint32_t operator()(uint32_t v) const { return t[0][v & 0xffu] ^ t[1][(v >> 8) & 0xffu] ^ t[2][(v >> 16) & 0xffu] ^ t[3][v >> 24]; }
+};
+
+constexpr uint32_t sobol_direction1(int k) {  // v_k of dimension 1
+    uint32_t v = 1u << 31;
+    for (int i = 0; i < k; ++i) v ^= v >> 1;
+    return v;
 }
+constexpr uint32_t reverse_bits32_constexpr(uint32_t x) {
+    uint32_t r = 0;
+    for (int i = 0; i < 32; ++i) r |= ((x >> i) & 1u) << (31 - i);
+    return r;
+}
+/// sobol_dimension1 itself, and the same map between bit-reversed words: reversed(sobol_1(reversed(z))),
+/// which lets the sampler stay in bit-reversed order between its two scrambles.
+inline constexpr BitMatrixTable kSobolDimension1{[](int k) { return sobol_direction1(k); }};
+inline constexpr BitMatrixTable kSobolDimension1Reversed{[](int k) { return reverse_bits32_constexpr(sobol_direction1(31 - k)); }};
+
+inline uint32_t sobol_dimension1(uint32_t index) { return kSobolDimension1(index); }
 
 /// Which 2D pair, and which coordinate of it, a dimension of docs/sampling.md's layout belongs to.
 /// Pairs are chosen so that 2D decisions are stratified jointly: filter (x, y), light position,
@@ -99,36 +130,69 @@ inline uint64_t sobol_pixel_key(uint64_t seed, uint32_t pixel) {
     return mix64(mix64(seed ^ 0x5851f42d4c957f2dULL) + pixel);
 }
 
+/// One pair's point for one sample, computed in bit-reversed order where it saves reversals:
+///   shuffled = owen(index, h_lo)            (padding: a different aligned block of the sequence)
+///   x_c      = owen(sobol_c(shuffled), h_hi ^ c)
+/// with owen(x) = rev(lk(rev(x))) and rev(shuffled) = lk(rev(index), h_lo):
+///   x_0 = rev(lk(shuffled, s_0)),  x_1 = rev(lk(R(rev(shuffled)), s_1)),  R = rev ∘ sobol_1 ∘ rev.
+struct SobolPairPoint {
+    uint64_t h;
+    uint32_t shuffled_reversed;
+    SobolPairPoint(uint64_t pixel_key, uint32_t pair, uint32_t reversed_index)
+        : h(mix64(pixel_key ^ (uint64_t(pair) * 0xd1b54a32d192ed03ULL))), shuffled_reversed(lk_hash(reversed_index, uint32_t(h))) {}
+    float coordinate(uint32_t c) const {
+        const uint32_t z = c == 0 ? reverse_bits32(shuffled_reversed) : kSobolDimension1Reversed(shuffled_reversed);
+        const uint32_t seed = uint32_t(h >> 32) ^ (c ? 0x9e3779b9u : 0u);
+        return float(reverse_bits32(lk_hash(z, seed)) >> 8) * 0x1.0p-24f;
+    }
+};
+
 /// Sample `index` of a pixel (its key) in `dimension`, in [0, 1).
 inline float sobol_sample(uint64_t pixel_key, uint32_t index, uint32_t dimension) {
     const DimensionPair d = dimension_pair(dimension);
-    const uint64_t h = mix64(pixel_key ^ (uint64_t(d.pair) * 0xd1b54a32d192ed03ULL));
-    // Shuffling the index by an Owen scramble keeps each power-of-two prefix inside one aligned
-    // block of the sequence (itself a (0,m,2)-net) while decorrelating the pairs (padding).
-    const uint32_t shuffled = owen_scramble(index, uint32_t(h));
-    const uint32_t x = d.coordinate == 0 ? sobol_dimension0(shuffled) : sobol_dimension1(shuffled);
-    const uint32_t scramble_seed = uint32_t(h >> 32) ^ (d.coordinate ? 0x9e3779b9u : 0u);
-    return float(owen_scramble(x, scramble_seed) >> 8) * 0x1.0p-24f;
+    return SobolPairPoint(pixel_key, d.pair, reverse_bits32(index)).coordinate(d.coordinate);
 }
 
 /// A per-sample view: the key is hashed once, each dimension costs one more mix (independent) or
-/// one scrambled Sobol point (Sobol).
+/// one scrambled Sobol coordinate (Sobol); get2 draws both coordinates of a pair for little more
+/// than one.
 struct SampleStream {
     uint64_t key;
     uint32_t index = 0;
+    uint32_t reversed_index = 0;  ///< Sobol: reverse_bits32(index), shared by every dimension
     SamplerKind kind = SamplerKind::Independent;
     SampleStream(uint64_t seed, uint32_t pixel, uint32_t sample_index, SamplerKind k = SamplerKind::Independent)
-        : key(k == SamplerKind::Sobol ? sobol_pixel_key(seed, pixel) : sample_key(seed, pixel, sample_index)),
-          index(sample_index), kind(k) {}
+        : SampleStream(k == SamplerKind::Sobol ? sobol_pixel_key(seed, pixel) : sample_key(seed, pixel, sample_index), sample_index, k) {}
     /// From a key hashed earlier (the tracer keeps one per path instead of rehashing per stage).
     static SampleStream from_key(uint64_t key, uint32_t sample_index, SamplerKind k) { return SampleStream(key, sample_index, k); }
     float get(uint32_t dimension) const {
-        return kind == SamplerKind::Sobol ? sobol_sample(key, index, dimension) : sample_from_key(key, dimension);
+        if (kind != SamplerKind::Sobol) return sample_from_key(key, dimension);
+        const DimensionPair d = dimension_pair(dimension);
+        return SobolPairPoint(key, d.pair, reversed_index).coordinate(d.coordinate);
+    }
+    /// get(dimension) and get(dimension + 1), which must be coordinates 0 and 1 of one pair (the
+    /// filter, light position and BSDF direction pairs of the layout).
+    void get2(uint32_t dimension, float& u0, float& u1) const {
+        if (kind != SamplerKind::Sobol) {
+            u0 = sample_from_key(key, dimension);
+            u1 = sample_from_key(key, dimension + 1);
+            return;
+        }
+        const SobolPairPoint p(key, dimension_pair(dimension).pair, reversed_index);
+        u0 = p.coordinate(0);
+        u1 = p.coordinate(1);
     }
 
 private:
-    SampleStream(uint64_t k, uint32_t i, SamplerKind s) : key(k), index(i), kind(s) {}
+    SampleStream(uint64_t k, uint32_t i, SamplerKind s) : key(k), index(i), reversed_index(s == SamplerKind::Sobol ? reverse_bits32(i) : 0), kind(s) {}
 };
+
+/// get2's precondition, checked at compile time for the pairs the tracer draws together.
+static_assert(dimension_pair(dim::kFilter).coordinate == 0 && dimension_pair(dim::kFilter + 1).pair == dimension_pair(dim::kFilter).pair);
+static_assert(dimension_pair(dim::bounce(3, dim::kLightPos)).coordinate == 0 &&
+              dimension_pair(dim::bounce(3, dim::kLightPos + 1)).pair == dimension_pair(dim::bounce(3, dim::kLightPos)).pair);
+static_assert(dimension_pair(dim::bounce(3, dim::kBsdfDir)).coordinate == 0 &&
+              dimension_pair(dim::bounce(3, dim::kBsdfDir + 1)).pair == dimension_pair(dim::bounce(3, dim::kBsdfDir)).pair);
 
 /// What regenerates a render's random numbers: its seed and sampler kind (path replay keeps it).
 struct SamplerId {
@@ -154,7 +218,10 @@ struct BsdfRandoms {
     float dir[2];
 };
 inline BsdfRandoms bsdf_randoms(const SampleStream& rng, uint32_t depth) {
-    return {rng.get(dim::bounce(depth, dim::kBsdfLobe)), {rng.get(dim::bounce(depth, dim::kBsdfDir)), rng.get(dim::bounce(depth, dim::kBsdfDir + 1))}};
+    BsdfRandoms u;
+    u.lobe = rng.get(dim::bounce(depth, dim::kBsdfLobe));
+    rng.get2(dim::bounce(depth, dim::kBsdfDir), u.dir[0], u.dir[1]);
+    return u;
 }
 
 }  // namespace lpt

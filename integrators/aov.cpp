@@ -20,7 +20,9 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
             float d_sum = 0.f;
             for (int s = 0; s < spp; ++s) {
                 SampleStream rng{seed, pixel, uint32_t(s), sampler};
-                Vec2f off = camera.filter.sample(Vec2f(rng.get(dim::kFilter), rng.get(dim::kFilter + 1)));
+                Vec2f u;
+                rng.get2(dim::kFilter, u.x(), u.y());
+                Vec2f off = camera.filter.sample(u);
                 Ray r = camera.generate_ray(Vec2f(x + 0.5f + off.x(), y + 0.5f + off.y()));
                 SurfaceInteraction si = scene.intersect(r);
                 if (!si.valid()) continue;

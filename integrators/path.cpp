@@ -114,8 +114,7 @@ private:
             p.key[k] = rng.key;
             fx[k] = float(x);
             fy[k] = float(y);
-            u0[k] = rng.get(dim::kFilter);
-            u1[k] = rng.get(dim::kFilter + 1);
+            rng.get2(dim::kFilter, u0[k], u1[k]);
         }
         RayArrays& rays = ws.rays[0];
         rays.resize_for_fill(n);
@@ -244,8 +243,7 @@ private:
                 const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler);
                 lb.rx[k] = sq.p[k].x(); lb.ry[k] = sq.p[k].y(); lb.rz[k] = sq.p[k].z();
                 lb.u_choice[k] = rng.get(dim::bounce(depth, dim::kLightChoice));
-                lb.u_pos0[k] = rng.get(dim::bounce(depth, dim::kLightPos));
-                lb.u_pos1[k] = rng.get(dim::bounce(depth, dim::kLightPos + 1));
+                rng.get2(dim::bounce(depth, dim::kLightPos), lb.u_pos0[k], lb.u_pos1[k]);
             }
             m_scene.lights.sample_batch(m_scene.emitters, m_scene.shapes, sq.size(), lb);
         }

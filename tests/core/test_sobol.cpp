@@ -157,6 +157,12 @@ TEST(Sobol, StreamsArePureFunctions) {
             const SampleStream a(9, 123, i, k);
             const SampleStream b = SampleStream::from_key(a.key, i, k);
             for (uint32_t d = 0; d < 40; ++d) EXPECT_EQ(a.get(d), b.get(d));
+            for (uint32_t d : {dim::kFilter, dim::bounce(2, dim::kLightPos), dim::bounce(2, dim::kBsdfDir)}) {
+                float u0, u1;
+                a.get2(d, u0, u1);
+                EXPECT_EQ(u0, a.get(d));
+                EXPECT_EQ(u1, a.get(d + 1)) << "get2 draws exactly what get draws";
+            }
         }
     }
     EXPECT_EQ(SampleStream(9, 1, 2, SamplerKind::Independent).get(5), sample_1d(9, 1, 2, 5)) << "independent sampler unchanged";
