@@ -31,7 +31,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from validate_renderer import blender_env, shared_dir  # noqa: E402
+from validate_renderer import blender_env, fingerprint, shared_dir  # noqa: E402
 
 SCENES = {  # name -> (scene file, converged reference under <shared>/scenes or None)
     "cornell-box": ("cornell-box/scene_v3.xml", "cornell-box/TungstenRender.exr"),
@@ -64,7 +64,8 @@ def cached(path, settings, force):
 
 def render(kind, args, scene, spp, seed, path):
     """Renders unless cached; returns render seconds (the renderer's own count)."""
-    settings = {"kind": kind, "scene": scene, "res": args.res, "spp": spp, "seed": seed}
+    tool = os.path.join(ROOT, "tools", "cycles_reference.py") if kind == "cycles" else args.bin
+    settings = {"kind": kind, "scene": scene, "res": args.res, "spp": spp, "seed": seed, "code": fingerprint(tool)}
     old = cached(path, settings, args.force)
     if old:
         return old["seconds"]

@@ -12,10 +12,12 @@ ratios, 32x32 block ratios against their noise, emitter-masked relMSE and pictur
     <out>/<scene>/compare/    comparison.txt/.json, side_by_side.png, ratio_map.png
     <out>/summary.md, summary.json
 
-Finished renders are reused when rerun with the same settings (resumable); --force redoes them.
+Finished renders are reused when rerun with the same settings and the same latentpt binary /
+translation script (resumable; a rebuilt latentpt renders again); --force redoes them.
 Without Blender the Cycles side is skipped and the summary says so.
 """
 import argparse
+import hashlib
 import json
 import os
 import shutil
@@ -66,9 +68,26 @@ def blender_env(blender):
     return env
 
 
+_FINGERPRINTS = {}
+
+
+def fingerprint(path):
+    """SHA-1 of a file (the latentpt binary, the translation script): a render made by other code
+    is not a finished render of this run."""
+    if path not in _FINGERPRINTS:
+        h = hashlib.sha1()
+        with open(path, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
+        _FINGERPRINTS[path] = h.hexdigest()
+    return _FINGERPRINTS[path]
+
+
 def render_once(kind, args, scene_path, out_exr, seed, extra, log):
-    """Renders unless out_exr exists with the same settings (kept in out_exr + '.settings')."""
-    settings = {"kind": kind, "scene": scene_path, "res": args.res, "spp": args.spp // 2, "seed": seed, "extra": extra}
+    """Renders unless out_exr exists with the same settings and code (kept in out_exr + '.settings')."""
+    tool = args.bin if kind == "ours" else os.path.join(ROOT, "tools", "cycles_reference.py")
+    settings = {"kind": kind, "scene": scene_path, "res": args.res, "spp": args.spp // 2, "seed": seed, "extra": extra,
+                "code": fingerprint(tool)}
     stamp = out_exr + ".settings"
     if not args.force and os.path.exists(out_exr) and os.path.exists(stamp):
         with open(stamp) as f:
