@@ -104,15 +104,16 @@ struct Row {
     double raw_seconds;
 };
 
-Row bench_scene(const std::string& name, const Scene& scene, const BenchArgs& a) {
+Row bench_scene(const std::string& name, const Scene& scene, const BenchArgs& a, SamplerKind sampler) {
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions opt = RenderOptions::from_scene(scene);
+    opt.sampler = sampler;
     opt.spp = a.spp;
     opt.width = opt.height = a.res;
     RenderOptions warm = opt;
     warm.spp = 1;
     render_path<3>(scene, spectra, warm);  // first-touch allocations and page faults out of the timing
-    Row row{name, 0, {}, 0.0};
+    Row row{name + " (" + sampler_name(sampler) + ")", 0, {}, 0.0};
     for (const Shape& s : scene.shapes) row.triangles += s.mesh.triangle_count();
     const size_t pool_n = 1 << 18;
     RayPool cam = camera_pool(scene, a.res, a.res, pool_n);
@@ -140,9 +141,12 @@ Row bench_scene(const std::string& name, const Scene& scene, const BenchArgs& a)
 int run_bench(const BenchArgs& a) {
     std::string path = a.scene.empty() ? std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json" : a.scene;
     std::vector<Row> rows;
+    // Both samplers: the tracer's own cost (independent, the figure of docs/performance.md) and
+    // what the default sampler's numbers add to it.
+    const SamplerKind samplers[] = {SamplerKind::Sobol, SamplerKind::Independent};
     {
         Scene scene = load_scene(path);
-        rows.push_back(bench_scene("cornell-box", scene, a));
+        for (SamplerKind s : samplers) rows.push_back(bench_scene("cornell-box", scene, a, s));
     }
     {
         // Heavy variant: the same box plus a finely tessellated sphere standing in the middle.
@@ -158,15 +162,15 @@ int run_bench(const BenchArgs& a) {
         sphere.material = scene.shapes.front().material;
         scene.shapes.push_back(std::move(sphere));
         scene.build();
-        rows.push_back(bench_scene("cornell-box+sphere", scene, a));
+        for (SamplerKind s : samplers) rows.push_back(bench_scene("cornell-box+sphere", scene, a, s));
     }
-    std::printf("%-20s %10s %12s %12s %12s %10s\n", "scene", "triangles", "rays", "pt Mrays/s", "raw Mrays/s", "pt/raw");
+    std::printf("%-32s %10s %12s %12s %12s %10s\n", "scene (sampler)", "triangles", "rays", "pt Mrays/s", "raw Mrays/s", "pt/raw");
     std::ostringstream js;
     js << "[";
     for (size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
         double pt = r.pt.rays() / r.pt.seconds * 1e-6, raw = r.pt.rays() / r.raw_seconds * 1e-6;
-        std::printf("%-20s %10zu %12llu %12.2f %12.2f %9.1f%%\n", r.name.c_str(), r.triangles, (unsigned long long)r.pt.rays(), pt, raw, 100.0 * pt / raw);
+        std::printf("%-32s %10zu %12llu %12.2f %12.2f %9.1f%%\n", r.name.c_str(), r.triangles, (unsigned long long)r.pt.rays(), pt, raw, 100.0 * pt / raw);
         js << (i ? "," : "") << "{\"scene\":\"" << r.name << "\",\"triangles\":" << r.triangles << ",\"rays\":" << r.pt.rays()
            << ",\"pt_mrays_per_s\":" << pt << ",\"raw_mrays_per_s\":" << raw << ",\"ratio\":" << pt / raw << "}";
     }

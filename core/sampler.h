@@ -197,7 +197,7 @@ static_assert(dimension_pair(dim::bounce(3, dim::kBsdfDir)).coordinate == 0 &&
 /// What regenerates a render's random numbers: its seed and sampler kind (path replay keeps it).
 struct SamplerId {
     uint64_t seed = 0;
-    SamplerKind kind = SamplerKind::Independent;
+    SamplerKind kind = SamplerKind::Sobol;
     SampleStream stream(uint32_t pixel, uint32_t sample_index) const { return SampleStream(seed, pixel, sample_index, kind); }
 };
 

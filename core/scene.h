@@ -19,7 +19,7 @@ struct IntegratorSettings {
     int max_depth = 8;   ///< longest path in segments, Mitsuba's semantics; -1 = unbounded
     int rr_depth = 5;    ///< Russian roulette from this depth on
     int spp = 16;        ///< default samples per pixel
-    SamplerKind sampler = SamplerKind::Independent;  ///< docs/sampling.md (sobol: opt-in until it is cheaper)
+    SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
     LightSampling light_sampling = LightSampling::Power;
 };
 

@@ -16,6 +16,6 @@ struct AovImages {
 };
 
 AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed,
-                      SamplerKind sampler = SamplerKind::Independent);
+                      SamplerKind sampler = SamplerKind::Sobol);
 
 }  // namespace lpt

@@ -27,7 +27,7 @@ struct RenderOptions {
     int max_depth = 8;           ///< Mitsuba semantics: 1 = emitters seen directly; -1 = unbounded
     int rr_depth = 5;
     LightStrategy strategy = LightStrategy::Mis;
-    SamplerKind sampler = SamplerKind::Independent;  ///< docs/sampling.md
+    SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
     /// Called now and then with (fraction done, rays traced so far); from a worker thread.
     std::function<void(double, uint64_t)> progress;
     /// The scene's settings; the sampler is the command line's `--sampler` where one was given

@@ -169,7 +169,8 @@ def main():
     for kind in ["independent", "sobol", "cycles"]:
         r = reach.get(kind)
         if kind == "cycles" and not have_blender:
-            lines.append("| Cycles | – (no Blender: `apt-get install blender`) | – | – | – | – |")
+            why = "not run (--no-cycles)" if args.no_cycles else "no Blender: `apt-get install blender`"
+            lines.append("| Cycles | – (%s) | – | – | – | – |" % why)
             continue
         name = {"independent": "latentpt independent", "sobol": "latentpt sobol", "cycles": "Cycles (CPU)"}[kind]
         lines.append("| %s | %s | %s | %s | %s | %s |" % (
