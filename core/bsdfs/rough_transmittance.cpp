@@ -14,20 +14,39 @@ namespace {
 constexpr int K = 32;             // quadrature grid K×K per table entry
 constexpr double kNodeStep = 0.125;  // Δs between nodes in s = ln(α / kMinAlpha)
 
-// Unclamped t(μ_j) and ∂t/∂α(μ_j) at one α: the raw node data.
+// Unclamped table values (a lobe's albedo at μ_j) and their ∂/∂α at one α: the raw node data.
 struct RawTables {
     std::array<double, kTransmittanceRes> t{}, dt{};
 };
 
-// A(μ) by a midpoint grid over the microfacet sampler's unit square (smooth in u, so O(K^-2)).
-double albedo(const MicrofacetDistribution& distr, float eta, const Vec3f& wi) {
+// The lobe's direction for microfacet m and its Fresnel factor: reflection with R, refraction
+// with 1 − R (Mitsuba's eval_reflectance / eval_transmittance integrands); false where the lobe
+// has no direction on its side (below the surface for reflection, total internal reflection or
+// back above it for refraction).
+bool lobe_direction(const Vec3f& wi, const Vec3f& m, float eta, CoatingLobe lobe, Vec3f& wo, double& fresnel) {
+    const FresnelDielectric f = fresnel_dielectric(wi.dot(m), eta);
+    if (lobe == CoatingLobe::Reflection) {
+        wo = reflect(wi, m);
+        fresnel = f.R;
+        return wo.z() > 0.f;
+    }
+    if (f.cos_t == 0.f) return false;
+    wo = refract(wi, m, f.cos_t, f.eta_ti);
+    fresnel = 1.0 - double(f.R);
+    return wo.z() < 0.f;
+}
+
+// The lobe's albedo at incidence wi, ∫ F_lobe D G |wi·m| / μ dm (reflection: A(μ), refraction:
+// T(μ); docs/bsdfs.md (26)), by a midpoint grid over the microfacet sampler's unit square
+// (smooth in u, so O(K^-2)); sample_weight is D G |wi·m| / (μ p(m)) for either side.
+double lobe_albedo(const MicrofacetDistribution& distr, float eta, const Vec3f& wi, CoatingLobe lobe) {
     double sum = 0.0;
     for (int a = 0; a < K; ++a)
         for (int b = 0; b < K; ++b) {
-            Vec3f m = distr.sample(wi, Vec2f((a + 0.5f) / K, (b + 0.5f) / K));
-            Vec3f wo = reflect(wi, m);
-            if (wo.z() <= 0.f) continue;
-            sum += fresnel_dielectric(wi.dot(m), eta).R * distr.sample_weight(wi, wo, m);
+            Vec3f m = distr.sample(wi, Vec2f((a + 0.5f) / K, (b + 0.5f) / K)), wo;
+            double fresnel;
+            if (!lobe_direction(wi, m, eta, lobe, wo, fresnel)) continue;
+            sum += fresnel * distr.sample_weight(wi, wo, m);
         }
     return sum / (K * K);
 }
@@ -39,7 +58,7 @@ double albedo(const MicrofacetDistribution& distr, float eta, const Vec3f& wi) {
 // Jacobian (10) turning p(m) into p(wo). For Beckmann, d ln D/dα = 2 (tan²θm/α² - 1)/α
 // grows like -ln(1 - u1) toward u1 = 1, which a midpoint rule integrates poorly; there
 // u1 = 1 - (1 - v)², du1 = 2 (1 - v) dv smooths the endpoint ((1 - v) ln(1 - v) → 0).
-double dalbedo_dalpha(const MicrofacetDistribution& distr, float eta, const Vec3f& wi) {
+double dreflectance_dalpha(const MicrofacetDistribution& distr, float eta, const Vec3f& wi) {
     const bool beckmann = distr.type() == MicrofacetType::Beckmann;
     double mu = wi.z(), sum = 0.0;
     for (int a = 0; a < K; ++a) {
@@ -59,14 +78,27 @@ double dalbedo_dalpha(const MicrofacetDistribution& distr, float eta, const Vec3
     return sum / (K * K);
 }
 
-RawTables raw_tables(MicrofacetType type, float eta, float alpha) {
+// Step in ln α of the transmittance's node slopes (central differences, O(δ²) ~ 1e-4 relative).
+constexpr double kSlopeStep = 0.01;
+
+RawTables raw_tables(MicrofacetType type, float eta, float alpha, CoatingLobe lobe) {
     MicrofacetDistribution distr(type, alpha);
+    // The transmittance's ∂/∂α comes from central differences of its own quadrature in ln α
+    // (the sample points move smoothly with α). The derivative integral, used for A, converges
+    // far too slowly for T on this grid: d ln D/dα grows like tan²θm/α² on tilted microfacets,
+    // which reflection sends below the horizon but refraction keeps (32×32: 45 % off T̄'s slope
+    // for Beckmann at α = 0.1, 128×128: 3.5 %). At the α floor the difference is one-sided.
+    const double up = std::exp(kSlopeStep), down = std::max(std::exp(-kSlopeStep), MicrofacetDistribution::kMinAlpha / double(alpha));
+    MicrofacetDistribution distr_up(type, float(alpha * up)), distr_down(type, float(alpha * down));
     RawTables r;
     for (int j = 0; j < kTransmittanceRes; ++j) {
         float mu = std::max(1e-6f, float(j) / (kTransmittanceRes - 1));
         Vec3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
-        r.t[j] = double(1.f - float(albedo(distr, eta, wi)));
-        r.dt[j] = -dalbedo_dalpha(distr, eta, wi);
+        r.t[j] = double(float(lobe_albedo(distr, eta, wi, lobe)));
+        if (lobe == CoatingLobe::Reflection)
+            r.dt[j] = dreflectance_dalpha(distr, eta, wi);
+        else
+            r.dt[j] = (lobe_albedo(distr_up, eta, wi, lobe) - lobe_albedo(distr_down, eta, wi, lobe)) / (double(alpha) * (up - down));
     }
     return r;
 }
@@ -102,14 +134,14 @@ struct Node {
 };
 
 std::mutex g_mutex;
-std::map<std::tuple<int, float, int>, std::unique_ptr<const Node>> g_nodes;
+std::map<std::tuple<int, int, float, int>, std::unique_ptr<const Node>> g_nodes;
 
-const Node& node(MicrofacetType type, float eta, int k) {
+const Node& node(MicrofacetType type, float eta, CoatingLobe lobe, int k) {
     std::lock_guard<std::mutex> lock(g_mutex);
-    auto& slot = g_nodes[{int(type), eta, k}];
+    auto& slot = g_nodes[{int(type), int(lobe), eta, k}];
     if (!slot) {
         float alpha_k = float(MicrofacetDistribution::kMinAlpha * std::exp(k * kNodeStep));
-        RawTables r = raw_tables(type, eta, alpha_k);
+        RawTables r = raw_tables(type, eta, alpha_k, lobe);
         auto n = std::make_unique<Node>();
         for (int j = 0; j < kTransmittanceRes; ++j) n->t[j] = r.t[j], n->dt_ds[j] = double(alpha_k) * r.dt[j];
         slot = std::move(n);
@@ -119,18 +151,18 @@ const Node& node(MicrofacetType type, float eta, int k) {
 
 }  // namespace
 
-TransmittanceTable rough_transmittance_direct(MicrofacetType type, float eta, float alpha) {
-    RawTables r = raw_tables(type, eta, std::max(alpha, MicrofacetDistribution::kMinAlpha));
+TransmittanceTable rough_lobe_table_direct(MicrofacetType type, float eta, float alpha, CoatingLobe lobe) {
+    RawTables r = raw_tables(type, eta, std::max(alpha, MicrofacetDistribution::kMinAlpha), lobe);
     return finish(r.t, r.dt);
 }
 
-TransmittanceTable rough_transmittance(MicrofacetType type, float eta, float alpha) {
+TransmittanceTable rough_lobe_table(MicrofacetType type, float eta, float alpha, CoatingLobe lobe) {
     // docs/bsdfs.md (46): cubic Hermite in s over [s_k, s_k+1], x = (s − s_k)/Δs.
     double s = std::log(std::max(double(alpha), double(MicrofacetDistribution::kMinAlpha)) / MicrofacetDistribution::kMinAlpha) / kNodeStep;
     int k = int(std::floor(s));
     double x = s - k, x2 = x * x, x3 = x2 * x;
-    const Node& a = node(type, eta, k);
-    const Node& b = node(type, eta, k + 1);
+    const Node& a = node(type, eta, lobe, k);
+    const Node& b = node(type, eta, lobe, k + 1);
     double h00 = 2 * x3 - 3 * x2 + 1, h10 = x3 - 2 * x2 + x, h01 = -2 * x3 + 3 * x2, h11 = x3 - x2;
     double d00 = 6 * x2 - 6 * x, d10 = 3 * x2 - 4 * x + 1, d01 = -6 * x2 + 6 * x, d11 = 3 * x2 - 2 * x;
     double ds_dalpha = 1.0 / double(alpha);  // ∂(ln α)/∂α; the 1/Δs of x is applied per term

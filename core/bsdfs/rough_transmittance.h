@@ -1,5 +1,7 @@
-// The rough coating's transmittance t(μ) = 1 − A(μ) for roughplastic (docs/bsdfs.md (26), (27),
-// (42), (46)), tabulated over 64 cosines μ_j = j/63, with its exact α-derivative.
+// The rough coating's tables for roughplastic (docs/bsdfs.md (26), (27), (42), (46)): the
+// transmittance T(μ) and the specular albedo A(μ) of a rough dielectric interface (Mitsuba's
+// eval_transmittance / eval_reflectance), tabulated over 64 cosines μ_j = j/63, with their exact
+// α-derivatives.
 //
 // Why a cache over α: a fit moves α every Adam step, and the direct quadrature costs 6–10 ms
 // per (t, ∂t/∂α) pair; 33 rough-plastic shapes (dining-room) spent > 90% of each step there.
@@ -17,21 +19,34 @@ namespace lpt {
 
 constexpr int kTransmittanceRes = 64;
 
+/// Which lobe of the interface a table integrates: the refracted energy T(μ) or the reflected A(μ).
+enum class CoatingLobe { Transmission, Reflection };
+
+/// One lobe's albedo over μ_j (named after its main use, the transmittance t).
 struct TransmittanceTable {
-    std::array<float, kTransmittanceRes> t{};   ///< t(μ_j), clamped to [0, 1]
-    std::array<float, kTransmittanceRes> dt{};  ///< ∂t/∂α(μ_j); 0 where t is clamped
+    std::array<float, kTransmittanceRes> t{};   ///< the lobe's albedo at μ_j, clamped to [0, 1]
+    std::array<float, kTransmittanceRes> dt{};  ///< its ∂/∂α at μ_j; 0 where t is clamped
     float mean = 0.f;                           ///< T̄ = 2 ∫ t(μ) μ dμ of the piecewise-linear t (27)
     float dmean = 0.f;                          ///< ∂T̄/∂α, the same functional of dt
 };
 
-/// The tables at roughness alpha (> 0) for relative IOR eta, interpolated from cached nodes
+/// A lobe's table at roughness alpha (> 0) for relative IOR eta, interpolated from cached nodes
 /// (docs/bsdfs.md (46)). Thread-safe; deterministic (a node depends only on its key).
-TransmittanceTable rough_transmittance(MicrofacetType type, float eta, float alpha);
+TransmittanceTable rough_lobe_table(MicrofacetType type, float eta, float alpha, CoatingLobe lobe);
+inline TransmittanceTable rough_transmittance(MicrofacetType type, float eta, float alpha) {
+    return rough_lobe_table(type, eta, alpha, CoatingLobe::Transmission);
+}
+inline TransmittanceTable rough_reflectance(MicrofacetType type, float eta, float alpha) {
+    return rough_lobe_table(type, eta, alpha, CoatingLobe::Reflection);
+}
 
-/// The tables by direct quadrature at alpha (uncached, 6–10 ms): the nodes of the above, and
-/// the reference its interpolation is tested against. dt here is the quadrature of the exact
-/// ∂t/∂α integral (42), not the slope of t's quadrature.
-TransmittanceTable rough_transmittance_direct(MicrofacetType type, float eta, float alpha);
+/// A lobe's table by direct quadrature at alpha (uncached, 6–10 ms): the nodes of the above,
+/// and the reference its interpolation is tested against. dt here is the quadrature of the
+/// exact derivative integral (42), not the slope of t's quadrature.
+TransmittanceTable rough_lobe_table_direct(MicrofacetType type, float eta, float alpha, CoatingLobe lobe);
+inline TransmittanceTable rough_transmittance_direct(MicrofacetType type, float eta, float alpha) {
+    return rough_lobe_table_direct(type, eta, alpha, CoatingLobe::Transmission);
+}
 
 /// Nodes computed so far by rough_transmittance (all distributions and IORs): for tests.
 size_t rough_transmittance_nodes_built();

@@ -1,14 +1,14 @@
 // "roughplastic": rough dielectric coating over a Lambertian base (Mitsuba 3's roughplastic):
 // a microfacet specular lobe plus a diffuse lobe attenuated by the coating's rough transmittance
-// t(mu) = 1 - (specular albedo at incidence mu) on the way in and out. One-sided.
+// t(mu) (the refracted energy at incidence mu, as Mitsuba's eval_transmittance) on the way in
+// and out. One-sided.
 // Keys: diffuse_reflectance (rgb, default 0.5); specular_reflectance (rgb, default 1);
 // distribution ("beckmann" | "ggx", default beckmann); alpha (float, default 0.1, > 0);
 // int_ior (default 1.49 = polypropylene), ext_ior (default 1.000277 = air), > 0 and distinct;
 // nonlinear (bool, default false).
 // Deviations from Mitsuba 3: lobe choice by the rough Fresnel albedo only (Mitsuba also weighs
 // by mean reflectances, signed in latent space); t(mu) is tabulated (64 entries, as Mitsuba)
-// by a stratified microfacet-sampling quadrature instead of Gauss-Lobatto, and t = 1 - A
-// (Mitsuba tabulates the rough transmittance, which also loses the transmitted side's shadowing).
+// by a stratified microfacet-sampling quadrature instead of Gauss-Lobatto.
 // The internal reflectance is Mitsuba's: 2 * mean_j A(mu_j; 1/eta) mu_j over the 64 table
 // cosines. It is not the smooth identity 1 - T/eta^2, so a white roughplastic loses 1-5 % of
 // its energy as in Mitsuba; with the identity, dining-room rendered 2.3 % brighter than a Cycles
@@ -165,13 +165,13 @@ private:
     void rebuild() {
         m_tables = rough_transmittance(m_distr.type(), m_eta, m_distr.alpha());
         // docs/bsdfs.md (27), (42): Mitsuba 3's internal reflectance, the 64-point mean
-        // 2 · mean_j A(μ_j; 1/η) μ_j of the coating's albedo seen from inside (t = 1 − A at 1/η).
-        const TransmittanceTable inside = rough_transmittance(m_distr.type(), 1.f / m_eta, m_distr.alpha());
+        // 2 · mean_j A(μ_j; 1/η) μ_j of the coating's specular albedo seen from inside.
+        const TransmittanceTable inside = rough_reflectance(m_distr.type(), 1.f / m_eta, m_distr.alpha());
         double f = 0.0, df = 0.0;
         for (int j = 0; j < kTransmittanceRes; ++j) {
             const double mu = std::max(1e-6, double(j) / (kTransmittanceRes - 1));
-            f += (1.0 - inside.t[j]) * mu;
-            df -= inside.dt[j] * mu;
+            f += inside.t[j] * mu;
+            df += inside.dt[j] * mu;
         }
         m_substrate.set_internal_reflectance(float(2.0 * f / kTransmittanceRes), float(2.0 * df / kTransmittanceRes));
     }

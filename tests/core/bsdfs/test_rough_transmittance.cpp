@@ -28,9 +28,10 @@ float max_abs(const std::array<float, kTransmittanceRes>& a) {
 TEST(RoughTransmittance, NodesReproduceTheDirectQuadrature) {
     // At a node the spline passes through the node's own quadrature with its slope.
     for (MicrofacetType type : kTypes)
+        for (CoatingLobe lobe : {CoatingLobe::Transmission, CoatingLobe::Reflection})
         for (int k : {40, 55, 64, 72}) {
             float alpha = node_alpha(k);
-            TransmittanceTable c = rough_transmittance(type, 1.49f, alpha), d = rough_transmittance_direct(type, 1.49f, alpha);
+            TransmittanceTable c = rough_lobe_table(type, 1.49f, alpha, lobe), d = rough_lobe_table_direct(type, 1.49f, alpha, lobe);
             const float dscale = max_abs(d.dt);
             for (int j = 0; j < kTransmittanceRes; ++j) {
                 EXPECT_NEAR(c.t[j], d.t[j], 1e-6f) << name(type) << " α " << alpha << " j " << j;
@@ -43,19 +44,20 @@ TEST(RoughTransmittance, NodesReproduceTheDirectQuadrature) {
 
 TEST(RoughTransmittance, BetweenNodesWithinQuadratureAccuracy) {
     // Between nodes the spline is compared with a fresh quadrature at that α. They differ by
-    // the quadrature's own α-wobble (its sample points move with α, and the node slopes come
-    // from a different quadrature, of the exact ∂t/∂α integral, than the node values) plus
-    // the spline's O(Δs⁴) truncation. Measured maxima (η = 1.49, three points per interval):
+    // the quadrature's own α-wobble (its sample points move with α; A's node slopes come from a
+    // different quadrature, of the exact ∂A/∂α integral, T's from central differences of its
+    // own) plus the spline's O(Δs⁴) truncation. Measured maxima for A (η = 1.49, three points per interval):
     // |Δt| <= 3.0e-4 (the table's own accuracy is ~1e-3); |Δ∂t/∂α| <= 4.3e-2 of the table's
     // largest |∂t/∂α| for α >= 0.05, 1.4e-1 for GGX at α = 0.01 (8e-2 with a 64×64
     // quadrature: it is the quadrature, not the spline); |ΔT̄| <= 5e-5, |Δ∂T̄/∂α| <= 1.1e-2.
     // A wrong spline derivative (a missing 1/Δs or 1/α) is off by 100% or more.
     for (MicrofacetType type : kTypes)
+        for (CoatingLobe lobe : {CoatingLobe::Transmission, CoatingLobe::Reflection})
         for (float a0 : {0.01f, 0.05f, 0.1f, 0.3f, 0.7f, 1.3f})
             for (double x : {0.25, 0.5, 0.75}) {
                 int k = node_index(a0);
                 float alpha = float(MicrofacetDistribution::kMinAlpha * std::exp((k + x) * kStep));
-                TransmittanceTable c = rough_transmittance(type, 1.49f, alpha), d = rough_transmittance_direct(type, 1.49f, alpha);
+                TransmittanceTable c = rough_lobe_table(type, 1.49f, alpha, lobe), d = rough_lobe_table_direct(type, 1.49f, alpha, lobe);
                 const float dscale = max_abs(d.dt), dbound = (a0 < 0.05f ? 0.2f : 6e-2f) * dscale;
                 ASSERT_GT(dscale, 0.f);
                 for (int j = 0; j < kTransmittanceRes; ++j) {
