@@ -187,8 +187,9 @@ TEST(PathTracer, SameSeedSameImageAtAnyThreadCount) {
         auto other = render(scene, 8, 43, LightStrategy::Mis, 40, 40, sampler);
         EXPECT_NE(0, std::memcmp(one.data(), other.data(), one.size() * sizeof(float))) << "seed must change the image";
         auto independent = render(scene, 8, 42, LightStrategy::Mis, 40, 40, SamplerKind::Independent);
-        if (sampler == SamplerKind::Sobol)
+        if (sampler == SamplerKind::Sobol) {
             EXPECT_NE(0, std::memcmp(one.data(), independent.data(), one.size() * sizeof(float))) << "the sampler must change the image";
+        }
     }
 }
 
