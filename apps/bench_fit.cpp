@@ -18,9 +18,7 @@ namespace lpt::app {
 int run_bench_fit(const BenchArgs& a) {
     std::string path = a.fit_scene;
     if (path.empty()) {
-        const char* env = std::getenv("LATENTPT_SHARED");
-        std::string shared = env ? env : std::string(LPT_SOURCE_DIR) + "/../shared";
-        path = shared + "/scenes/cbox/cbox_specular.xml";
+        path = shared_dir() + "/scenes/cbox/cbox_specular.xml";
         if (!std::filesystem::exists(path)) path = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json";
     }
     Scene scene = load_scene(path);

@@ -63,10 +63,15 @@ struct BenchArgs {
     std::vector<int> fit_spp{16, 64, 256};
     std::string equal_error;      ///< fit folder: latent vs RGB time to equal error
     int max_spp = 1024;           ///< --equal-error: highest RGB spp (latent: a quarter of it)
+    bool equal_noise = false;     ///< spp and seconds to a noise target, Sobol vs independent
+    std::string reference;        ///< --equal-noise: converged reference (default: Tungsten's, cornell box)
+    int target_spp = 64;          ///< --equal-noise: target = the independent sampler's noise at this spp
+    int seeds = 2;                ///< --equal-noise: renders per ladder point
 };
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);
 int run_bench_equal_error(const BenchArgs& args);
+int run_bench_equal_noise(const BenchArgs& args);
 
 /// Stage 2 on a fit folder: trains the refiner on the folder's final render (latent.exr, aov.exr)
 /// against target.exr (and reference_rgb.exr for LPIPS when present).
@@ -134,6 +139,8 @@ struct CompareArgs {
 };
 int run_compare(const CompareArgs& a);
 
+/// The shared data folder: LATENTPT_SHARED, else ../shared beside the source tree.
+std::string shared_dir();
 /// ../shared (LATENTPT_SHARED overrides) + "/models/taesd3" unless `dir` is given.
 std::string default_vae_dir(const std::string& dir);
 /// ../shared (LATENTPT_SHARED overrides) + "/models/lpips" unless `dir` is given.

@@ -55,6 +55,13 @@ int main(int argc, char** argv) {
                                                       "the same latent error, and latent + decode vs RGB for the same image error")
         ->check(CLI::ExistingDirectory);
     bench->add_option("--max-spp", b.max_spp, "with --equal-error: highest RGB spp (latent side: a quarter)")->capture_default_str();
+    bench->add_flag("--equal-noise", b.equal_noise, "spp and render seconds to one noise level, Sobol vs independent sampler, against a converged "
+                                                    "reference (default scene: ../shared cornell-box scene_v3.xml; docs/sampling.md)");
+    bench->add_option("--reference", b.reference, "with --equal-noise: converged reference EXR (default: TungstenRender.exr beside the scene)")
+        ->check(CLI::ExistingFile);
+    bench->add_option("--target-spp", b.target_spp, "with --equal-noise: target = the independent sampler's noise at this spp (4 ... 256)")
+        ->capture_default_str();
+    bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")->capture_default_str()->check(CLI::PositiveNumber);
 
     FitArgs f;
     std::vector<std::string> fit_defines;
@@ -182,7 +189,8 @@ int main(int argc, char** argv) {
             if (!r.edit.empty()) return run_render_edit(r);
             return run_render(r);
         }
-        if (*bench) return !b.equal_error.empty() ? run_bench_equal_error(b) : b.fit ? run_bench_fit(b) : run_bench(b);
+        if (*bench)
+            return !b.equal_error.empty() ? run_bench_equal_error(b) : b.equal_noise ? run_bench_equal_noise(b) : b.fit ? run_bench_fit(b) : run_bench(b);
         if (*encode) return run_encode(v);
         if (*decode) return run_decode(v);
         if (*viz) return run_viz(v);

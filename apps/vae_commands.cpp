@@ -22,17 +22,14 @@ namespace lpt::app {
 
 namespace fs = std::filesystem;
 
-std::string default_vae_dir(const std::string& dir) {
-    if (!dir.empty()) return dir;
+std::string shared_dir() {
     const char* env = std::getenv("LATENTPT_SHARED");
-    return (env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared") + "/models/taesd3";
+    return env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared";
 }
 
-std::string default_lpips_dir(const std::string& dir) {
-    if (!dir.empty()) return dir;
-    const char* env = std::getenv("LATENTPT_SHARED");
-    return (env ? std::string(env) : std::string(LPT_SOURCE_DIR) + "/../shared") + "/models/lpips";
-}
+std::string default_vae_dir(const std::string& dir) { return dir.empty() ? shared_dir() + "/models/taesd3" : dir; }
+
+std::string default_lpips_dir(const std::string& dir) { return dir.empty() ? shared_dir() + "/models/lpips" : dir; }
 
 float display_value(float v, const std::string& tone) {
     v = tone == "reinhard" ? std::abs(v) / (1.f + std::abs(v)) : std::clamp(v, 0.f, 1.f);

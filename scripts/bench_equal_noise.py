@@ -1,23 +1,25 @@
 #!/usr/bin/env python3
 """Equal-noise benchmark (docs/sampling.md, "Equal noise"): samples per pixel and seconds each
 renderer needs to reach one noise level on a scene, measured in one run on one machine:
-latentpt with the independent sampler, latentpt with Owen-scrambled Sobol, and Blender Cycles
-(tools/cycles_reference.py; Debian's `blender`, installed on demand, validation only: without it
-the Cycles column stays empty and the report says so).
+latentpt with the independent sampler and with Owen-scrambled Sobol (`latentpt bench
+--equal-noise`), and Blender Cycles on the same spp ladder (tools/cycles_reference.py; Debian's
+`blender`, installed on demand, validation only: without it the Cycles column stays empty and
+the report says so).
 
 Noise = emitter-masked relMSE (`latentpt compare`, docs/validation.md (3)) against a converged
 reference: Bitterli's Tungsten render for cornell-box, else a high-spp latentpt render made once
-and cached. Each renderer renders at a ladder of spp (each point the mean relMSE of --seeds
-renders); the spp and the render time to reach the target are interpolated log-log between the
-two ladder points around it. Target: the independent sampler's noise at --target-spp.
+and cached. Each renderer renders the ladder 4, 8, ..., 256 spp (each point the mean relMSE of
+--seeds renders); the spp and the render time to reach the target are interpolated log-log
+between the two ladder points around it. Target: the independent sampler's noise at --target-spp.
 Render times are the renderers' own (latentpt's printed render time, Cycles' render time in its
 sidecar JSON): process start-up and scene translation are left out on both sides.
 
     python3 scripts/bench_equal_noise.py                       # cornell-box, 256x256
     python3 scripts/bench_equal_noise.py --scene cbox-specular
 
-Outputs <out>/<scene>/report.md and report.json (written atomically); renders are kept and reused
-when rerun with the same settings (--force redoes them).
+Outputs <out>/<scene>/report.md and report.json (written atomically); Cycles renders and the
+cached reference are kept and reused when rerun with the same settings and code (--force redoes
+them); latentpt's ladders are rendered anew each run.
 """
 import argparse
 import json
@@ -113,7 +115,6 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scene", default="cornell-box", choices=sorted(SCENES))
     ap.add_argument("--res", type=int, default=256)
-    ap.add_argument("--ladder", default="4,8,16,32,64,128,256", help="spp of the measured points")
     ap.add_argument("--target-spp", type=int, default=64, help="target noise = the independent sampler's at this spp")
     ap.add_argument("--seeds", type=int, default=2, help="renders per ladder point (their relMSE is averaged)")
     ap.add_argument("--ref-spp", type=int, default=4096, help="spp of the cached reference where no converged one ships")
@@ -138,11 +139,19 @@ def main():
         ref = os.path.join(folder, "reference.exr")
         render("sobol", argparse.Namespace(**{**vars(args), "force": False}), scene, args.ref_spp, 1000, ref)
         ref_note = "latentpt, Sobol, %d spp (its own noise is a floor under every relMSE)" % args.ref_spp
-    ladder_spp = [int(s) for s in args.ladder.split(",")]
+    ours_json = os.path.join(folder, "latentpt.json")
+    run([args.bin, "--threads", str(args.threads), "bench", "--equal-noise", "--scene", scene, "--reference", ref, "--res", str(args.res),
+         "--target-spp", str(args.target_spp), "--seeds", str(args.seeds), "--json", ours_json])
+    with open(ours_json) as f:
+        ours = json.load(f)
+    ladders = {k: [tuple(p) for p in v] for k, v in ours["ladders"].items()}
+    target = ours["target"]
+    ladder_spp = [p[0] for p in ladders["independent"]]
+    for kind in ("independent", "sobol"):
+        for spp, sec, err in ladders[kind]:
+            print("equal-noise: %-11s %4d spp  %7.2f s  relMSE %.6f" % (kind, spp, sec, err), flush=True)
     have_blender = not args.no_cycles and shutil.which(args.blender) is not None
-    kinds = ["independent", "sobol"] + (["cycles"] if have_blender else [])
-    ladders = {}
-    for kind in kinds:
+    for kind in ["cycles"] if have_blender else []:
         pts = []
         for spp in ladder_spp:
             secs, errs = [], []
@@ -153,9 +162,6 @@ def main():
             pts.append((spp, sum(secs) / len(secs), sum(errs) / len(errs)))
             print("equal-noise: %-11s %4d spp  %7.2f s  relMSE %.6f" % (kind, spp, pts[-1][1], pts[-1][2]), flush=True)
         ladders[kind] = pts
-    target = next(e for s, _, e in ladders["independent"] if s == args.target_spp) if args.target_spp in ladder_spp else None
-    if target is None:
-        sys.exit("bench_equal_noise: --target-spp must be one of the ladder's spp")
     reach = {k: to_target(v, target) for k, v in ladders.items()}
 
     def cell(v, fmt):

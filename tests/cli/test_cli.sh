@@ -17,6 +17,12 @@ scene="$src/scenes/cornell-box/scene.json"
 
 "$bin" render "$scene" --spp 2 --res 24x16 --aov --aov-res 6x4 -q --out "$out/r.exr"
 check test -s "$out/r.exr"; check test -s "$out/r.png"; check test -s "$out/r.normal.exr"
+
+# Equal-noise bench end to end at toy size against a 64-spp reference, and its missing-reference error.
+"$bin" render "$scene" --spp 64 --res 16x16 -q --out "$out/noise_ref.exr"
+check sh -c "'$bin' bench --equal-noise --scene '$scene' --reference '$out/noise_ref.exr' --res 16 --seeds 1 --target-spp 4 --json '$out/noise.json' 2>/dev/null | grep -q 'sobol: .* fewer spp'"
+check grep -q '"sobol":\[\[4,' "$out/noise.json"
+expect_error "TungstenRender.exr" "$bin" bench --equal-noise --scene "$scene"
 small_refiner="--refiner-iterations 4 --refiner-expansion 1 --refiner-checkpoint-every 2"
 "$bin" fit "$scene" --synthetic-res 8x8 --iterations 20 --spp 2 --final-spp 4 --checkpoint-every 10 -q -D integrator.max_depth=3 $small_refiner --out "$out/fit"
 for f in params.json latent.exr latent_e.exr latent_a.exr latent_c.exr aov.exr loss.csv target.png render.png diff.png checkpoint/state.json \
