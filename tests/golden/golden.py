@@ -1,0 +1,177 @@
+#!/usr/bin/env python3
+"""Outputs of render, fit (both stages) and edit rendering, compared bit for bit with the ones the
+code wrote before a refactor (tests/golden/golden.json).
+
+A restructuring must not change a single output bit: this runs a fixed set of small commands on the
+bundled scenes (and ../shared's when present), hashes every image's pixels (oiiotool --hash, so file
+metadata does not count) and every JSON / CSV with its timings and absolute paths removed, and
+compares the hashes with the stored ones. `--update` stores the current hashes instead: run it only
+on the commit whose outputs define the reference, and say so in that commit.
+
+Floating-point results depend on the CPU's instruction set (Embree picks its kernels at run time), so
+the stored hashes hold for the machine that wrote them: the CI machine. The manifest records that
+machine's CPU model; on another CPU the test reports the mismatch as a skip (exit 77), not a failure.
+"""
+import argparse
+import csv
+import hashlib
+import io
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+MANIFEST = os.path.join(HERE, "golden.json")
+IMAGE_EXT = (".exr", ".png")
+VOLATILE_KEYS = ("seconds", "seconds_per_iteration", "scene", "vae_dir", "lpips_dir", "target", "fitdir",
+                 "reference", "vae_encoder", "vae_decoder", "vae_config", "out")
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def commands(b, src, shared, out):
+    """(name, argv, outputs folder or file prefix): every run is tiny (the whole set takes ~15 s)."""
+    box = os.path.join(src, "scenes/cornell-box/scene.json")
+    edits = os.path.join(src, "scenes/cornell-box/edits-demo.json")
+    small_refiner = ["--refiner-iterations", "4", "--refiner-expansion", "1"]
+    runs = [
+        ("render_box", [b, "render", box, "--spp", "4", "--res", "32x32", "--aov", "--aov-res", "8x8",
+                        "--out", f"{out}/render_box/r.exr"]),
+        ("render_box_independent", [b, "--sampler", "independent", "render", box, "--spp", "3", "--res", "24x16",
+                                    "--strategy", "nee", "--out", f"{out}/render_box_independent/r.exr"]),
+        ("fit_box", [b, "fit", box, "--synthetic-res", "8x8", "--iterations", "20", "--spp", "2", "--final-spp", "4",
+                     "-D", "integrator.max_depth=3", *small_refiner, "--out", f"{out}/fit_box"]),
+        ("fit_box_replay", [b, "fit", box, "--synthetic-res", "8x8", "--iterations", "12", "--spp", "2",
+                            "--final-spp", "4", "--reuse-paths", "0", "--param", "paper", "--gate", "visible",
+                            "--no-refiner", "--out", f"{out}/fit_box_replay"]),
+        ("edit_box", [b, "render", f"{out}/fit_box", "--edit", edits, "--out", f"{out}/edit_box"]),
+    ]
+    xml_scenes = [("cbox_specular", "scenes/cbox/cbox_specular.xml", "32x32", "4"),
+                  ("veach_bidir", "scenes/veach-bidir/scene_v3.xml", "32x24", "2"),
+                  ("dining_room", "scenes/dining-room/scene_diffuse.xml", "32x24", "2"),
+                  ("classroom", "scenes/classroom/scene_constant.xml", "32x24", "2")]
+    for name, rel, res, spp in xml_scenes:
+        path = os.path.join(shared, rel)
+        if os.path.exists(path):
+            runs.append((f"render_{name}", [b, "render", path, "--spp", spp, "--res", res,
+                                            "--out", f"{out}/render_{name}/r.exr"]))
+    cbox = os.path.join(shared, "scenes/cbox/cbox_specular.xml")
+    if os.path.exists(cbox) and os.path.isdir(os.path.join(shared, "models/taesd3")):
+        runs.append(("fit_cbox_encoded", [b, "fit", cbox, "--encode", "--encode-res", "64x64", "--ref-spp", "8",
+                                          "--iterations", "10", "--spp", "2", "--final-spp", "4", *small_refiner,
+                                          "--out", f"{out}/fit_cbox_encoded"]))
+    return runs
+
+
+def image_hash(path):
+    r = subprocess.run(["oiiotool", "--hash", "--info", path], capture_output=True, text=True, check=True)
+    for line in r.stdout.splitlines():
+        if "SHA-1:" in line:
+            return line.split("SHA-1:", 1)[1].strip()
+    raise RuntimeError(f"oiiotool printed no SHA-1 for {path}")
+
+
+def scrub(value):
+    if isinstance(value, dict):
+        return {k: scrub(v) for k, v in value.items() if k not in VOLATILE_KEYS}
+    if isinstance(value, list):
+        return [scrub(v) for v in value]
+    return value
+
+
+def text_hash(path):
+    with open(path, newline="") as f:
+        text = f.read()
+    if path.endswith(".json"):
+        text = json.dumps(scrub(json.loads(text)), sort_keys=True)
+    elif path.endswith(".csv"):
+        rows = list(csv.reader(io.StringIO(text)))
+        keep = [i for i, h in enumerate(rows[0]) if h != "seconds"] if rows else []
+        text = "\n".join(",".join(r[i] for i in keep) for r in rows)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def hash_outputs(folder):
+    hashes = {}
+    for root, dirs, files in os.walk(folder):
+        dirs[:] = [d for d in dirs if d != "checkpoint"]  # resume state, covered by the CLI test
+        for name in sorted(files):
+            path = os.path.join(root, name)
+            rel = os.path.relpath(path, folder)
+            if name.endswith(IMAGE_EXT):
+                hashes[rel] = image_hash(path)
+            elif name.endswith((".json", ".csv")):
+                hashes[rel] = text_hash(path)
+    return hashes
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", required=True, help="the latentpt binary")
+    ap.add_argument("--src", default=os.path.dirname(os.path.dirname(HERE)), help="source tree")
+    ap.add_argument("--shared", default=None, help="shared data (default: LATENTPT_SHARED or ../shared)")
+    ap.add_argument("--out", default=None, help="keep the outputs here (default: a temporary folder)")
+    ap.add_argument("--update", action="store_true", help="store the current hashes as the reference")
+    args = ap.parse_args()
+    shared = args.shared or os.environ.get("LATENTPT_SHARED") or os.path.join(args.src, "..", "shared")
+
+    with tempfile.TemporaryDirectory(prefix="latentpt-golden-") as tmp:
+        out = args.out or tmp
+        current = {}
+        for name, argv in commands(args.bin, args.src, shared, out):
+            r = subprocess.run([*argv, "-q"], capture_output=True, text=True)
+            if r.returncode != 0:
+                print(f"{name}: exit {r.returncode}\n{r.stderr}", file=sys.stderr)
+                return 1
+            folder = os.path.join(out, name)
+            current[name] = hash_outputs(folder)
+
+    if args.update:
+        doc = {"cpu": cpu_model(), "runs": current}
+        tmp_path = MANIFEST + ".tmp"
+        with open(tmp_path, "w") as f:
+            json.dump(doc, f, indent=1, sort_keys=True)
+            f.write("\n")
+        os.replace(tmp_path, MANIFEST)
+        print(f"stored {sum(len(v) for v in current.values())} hashes from {len(current)} runs in {MANIFEST}")
+        return 0
+
+    with open(MANIFEST) as f:
+        stored = json.load(f)
+    differ, missing = [], []
+    for name, files in stored["runs"].items():
+        if name not in current:
+            missing.append(name)
+            continue
+        for rel, h in files.items():
+            if current[name].get(rel) != h:
+                differ.append(f"{name}/{rel}")
+        for rel in current[name].keys() - files.keys():
+            differ.append(f"{name}/{rel} (new output)")
+    checked = sum(len(current.get(n, {})) for n in stored["runs"])
+    if missing:
+        print(f"not run (no ../shared data?): {', '.join(missing)}")
+    if differ:
+        print(f"{len(differ)} of {checked} outputs differ from the stored ones:\n  " + "\n  ".join(differ))
+        if stored.get("cpu") != cpu_model():
+            print(f"stored on '{stored.get('cpu')}', this is '{cpu_model()}': skipped")
+            return 77
+        return 1
+    print(f"{checked} outputs bit-identical to the stored ones ({len(current)} runs)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
