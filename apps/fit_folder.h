@@ -4,7 +4,7 @@
 #pragma once
 #include "apps/commands.h"
 #include "autodiff/fit.h"
-#include "autodiff/latent_model.h"
+#include "latent/latent_model.h"
 #include "autodiff/tone_curve.h"
 #include "core/scene.h"
 #include <map>

@@ -2,7 +2,7 @@
 // the fit's final render and writes refiner.pt, the refined latent, its decoded PNG, the loss
 // curve and metrics.json (decoded rendered / refined / VAE round trip against the reference).
 #include "apps/commands.h"
-#include "autodiff/latent_model.h"
+#include "latent/latent_model.h"
 #include "autodiff/loss.h"
 #include "integrators/aov.h"
 #include "core/image_io.h"

@@ -4,7 +4,7 @@
 // the same result as an uninterrupted run. docs/fitting.md.
 #pragma once
 #include "autodiff/adam.h"
-#include "autodiff/latent_model.h"
+#include "latent/latent_model.h"
 #include "autodiff/tone_curve.h"
 #include <functional>
 #include <string>

@@ -6,7 +6,7 @@
 // by a BSDF value. Deterministic: per-tile gradient buffers are reduced in tile order.
 // Equations: docs/path-replay.md.
 #pragma once
-#include "autodiff/latent_model.h"
+#include "latent/latent_model.h"
 #include "integrators/path.h"
 #include <vector>
 

@@ -7,7 +7,7 @@
 // tracer completes them and then forgets them: memory stays one wavefront. `fit --reuse-paths K`
 // keeps a whole frame's records and replays them for K iterations without tracing a ray.
 #pragma once
-#include "autodiff/latent_model.h"
+#include "latent/latent_model.h"
 #include "integrators/path.h"
 #include <cstdint>
 #include <memory>

@@ -1,5 +1,5 @@
 // ParamStore: maps, their derivatives (central differences), clamps and JSON round trip.
-#include "core/param_store.h"
+#include "latent/param_store.h"
 #include <gtest/gtest.h>
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "core/param_store.h"
+#include "latent/param_store.h"
 #include "core/sampler.h"
 #include <nlohmann/json.hpp>
 #include <algorithm>

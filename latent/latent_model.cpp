@@ -1,4 +1,4 @@
-#include "autodiff/latent_model.h"
+#include "latent/latent_model.h"
 #include "core/sampler.h"
 #include <algorithm>
 #include <stdexcept>
@@ -10,16 +10,6 @@ Parameterisation parameterisation_from_string(const std::string& s) {
     if (s == "code") return Parameterisation::Code;
     if (s == "classic") return Parameterisation::Classic;
     throw std::invalid_argument("unknown parameterisation '" + s + "' (known: paper, code, classic)");
-}
-
-void split_materials_per_shape(Scene& scene) {
-    std::vector<Props> per_shape;
-    per_shape.reserve(scene.shapes.size());
-    for (Shape& s : scene.shapes) {
-        per_shape.push_back(scene.materials[s.material]);
-        s.material = int(per_shape.size()) - 1;
-    }
-    scene.materials = std::move(per_shape);
 }
 
 namespace {
@@ -40,9 +30,8 @@ SliceSpec spec_for(Parameterisation p, bool reflectance_like) {
 
 }  // namespace
 
-LatentModel::LatentModel(Scene& scene, Parameterisation p, uint64_t seed) : m_scene(scene) {
-    split_materials_per_shape(m_scene);
-    m_spectra = SceneSpectra<kLatentChannels>::from_description(m_scene);
+LatentModel::LatentModel(const Scene& scene, Parameterisation p, uint64_t seed) : m_scene(scene) {
+    m_spectra = SceneSpectra<kLatentChannels>::per_shape(m_scene);
     m_slots.resize(m_scene.shapes.size());
     auto add = [&](const std::string& name, const std::string& kind, bool refl) {
         SliceSpec s = spec_for(p, refl);
@@ -53,7 +42,7 @@ LatentModel::LatentModel(Scene& scene, Parameterisation p, uint64_t seed) : m_sc
         const Shape& shape = m_scene.shapes[i];
         ShapeSlots& sl = m_slots[i];
         if (shape.emitter >= 0) sl.Le = add(shape.id + ".Le", "Le", false);
-        const BSDF<kLatentChannels>& bsdf = *m_spectra.bsdfs[shape.material];
+        const BSDF<kLatentChannels>& bsdf = m_spectra.bsdf_of(int(i));
         if (!bsdf.is_delta()) {
             sl.La = add(shape.id + ".La", "La", false);
             sl.Lc = add(shape.id + ".Lc", "Lc", false);
@@ -74,7 +63,7 @@ LatentModel::LatentModel(Scene& scene, Parameterisation p, uint64_t seed) : m_sc
     // Scalars (roughness) start where the scene file puts them, inside the sigmoid's range.
     for (size_t i = 0; i < m_scene.shapes.size(); ++i)
         for (const auto& [key, slice] : m_slots[i].scalar) {
-            float v = std::clamp(m_spectra.bsdfs[m_scene.shapes[i].material]->get_scalar(key), 1e-3f, 0.999f);
+            float v = std::clamp(m_spectra.bsdf_of(int(i)).get_scalar(key), 1e-3f, 0.999f);
             m_params.set_value(slice, &v);
         }
 
@@ -92,8 +81,8 @@ void LatentModel::sync() {
         if (sl.Le >= 0) m_spectra.radiance[shape.emitter] = vec(sl.Le);
         m_terms.La[i] = sl.La >= 0 ? Latent(vec(sl.La)) : Latent::Zero();
         m_terms.Lc[i] = sl.Lc >= 0 ? Latent(vec(sl.Lc)) : Latent::Zero();
-        for (const auto& [key, slice] : sl.bsdf) m_spectra.bsdfs[shape.material]->set_spectral(key, vec(slice));
-        for (const auto& [key, slice] : sl.scalar) m_spectra.bsdfs[shape.material]->set_scalar(key, *m_params.value(slice));
+        for (const auto& [key, slice] : sl.bsdf) m_spectra.bsdf_of(int(i)).set_spectral(key, vec(slice));
+        for (const auto& [key, slice] : sl.scalar) m_spectra.bsdf_of(int(i)).set_scalar(key, *m_params.value(slice));
     }
     if (m_env_slot >= 0) m_spectra.radiance[m_scene.environment] = vec(m_env_slot);
     m_terms.background = vec(m_background);

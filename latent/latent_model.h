@@ -1,21 +1,20 @@
 // LatentModel: the learnable latent scene. For every shape it owns ParamStore slices
 // ("<id>.Le" for emitters, "<id>.La"/"<id>.Lc" for non-delta shapes, "<id>.bsdf.<key>" for each
 // BSDF coefficient) plus "background", and writes their values into the N = 16 spectra and
-// latent terms the renderer reads. Materials are split per shape first, so two shapes that
-// share a BSDF in the scene file still learn their own reflectance (the paper's per-shape model).
+// latent terms the renderer reads. Its spectra hold one BSDF per shape, so two shapes that share a
+// BSDF in the scene file still learn their own reflectance (the paper's per-shape model); the
+// scene itself is only read.
 // Parameterisations: docs/params.md.
 #pragma once
-#include "core/param_store.h"
 #include "core/scene.h"
 #include "core/scene_spectra.h"
 #include "integrators/path.h"
+#include "latent/latent.h"
+#include "latent/param_store.h"
 #include <string>
 #include <vector>
 
 namespace lpt {
-
-constexpr int kLatentChannels = 16;
-using Latent = Spectrum<kLatentChannels>;
 
 /// Paper: signed values as pos − neg parts clipped to [0, hi], init U[0, 1] (reflectance parts
 /// in [0, 1]). Code (public implementation): reflectance = sigmoid(raw), init raw U[−1, 1];
@@ -29,9 +28,9 @@ Parameterisation parameterisation_from_string(const std::string& s);  ///< "pape
 
 class LatentModel {
 public:
-    /// Splits `scene`'s materials per shape (scene is modified and must outlive the model),
-    /// creates every slice and initialises it deterministically from `seed`.
-    LatentModel(Scene& scene, Parameterisation p, uint64_t seed);
+    /// Creates every slice and initialises it deterministically from `seed`. `scene` is read,
+    /// never modified, and must outlive the model (edits of its shapes are seen by the model).
+    LatentModel(const Scene& scene, Parameterisation p, uint64_t seed);
 
     struct ShapeSlots {
         int Le = -1, La = -1, Lc = -1;
@@ -42,7 +41,6 @@ public:
     /// Writes ParamStore values into spectra and terms (call after every optimiser step).
     void sync();
 
-    Scene& scene() { return m_scene; }
     const Scene& scene() const { return m_scene; }
     ParamStore& params() { return m_params; }
     const ParamStore& params() const { return m_params; }
@@ -54,15 +52,12 @@ public:
     int background_slot() const { return m_background; }
 
 private:
-    Scene& m_scene;
+    const Scene& m_scene;
     ParamStore m_params;
     SceneSpectra<kLatentChannels> m_spectra;
     LatentTerms<kLatentChannels> m_terms;
     std::vector<ShapeSlots> m_slots;
     int m_env_slot = -1, m_background = -1;
 };
-
-/// Gives each shape its own copy of its material description.
-void split_materials_per_shape(Scene& scene);
 
 }  // namespace lpt
