@@ -7,7 +7,8 @@
 // renderer's best error (its model-error floor), and each side's time is that of the smallest
 // spp at or below it. docs/performance.md.
 #include "apps/commands.h"
-#include "apps/fit_folder.h"
+#include "pipeline/fit_folder.h"
+#include "pipeline/reference.h"
 #include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "integrators/path.h"
@@ -48,7 +49,7 @@ double time_to(const std::vector<Point>& pts, double threshold, bool latent_erro
 }  // namespace
 
 int run_bench_equal_error(const BenchArgs& a) {
-    FitFolder fit = load_fit_folder(a.equal_error);
+    pipeline::FitFolder fit = pipeline::load_fit_folder(a.equal_error);
     const fs::path dir(a.equal_error);
     const int w = fit.latent_width, h = fit.latent_height, W = 8 * w, H = 8 * h;
     if (!fs::exists(dir / "reference_rgb.exr")) throw std::runtime_error((dir / "reference_rgb.exr").string() + ": missing (the fit needs --encode)");
@@ -56,7 +57,7 @@ int run_bench_equal_error(const BenchArgs& a) {
     const Image ref_rgb = read_image((dir / "reference_rgb.exr").string());
     if (target.width != w || target.height != h || ref_rgb.width != W || ref_rgb.height != H || ref_rgb.channels != 3)
         throw std::runtime_error(a.equal_error + ": target.exr / reference_rgb.exr do not match the fit's latent size");
-    auto vae = open_vae(fit.vae);
+    auto vae = pipeline::open_vae(fit.vae);
     const SceneSpectra<3> rgb_spectra = SceneSpectra<3>::from_description(*fit.scene);
     const uint64_t seed = 1;  // the reference used 0x5eed: independent samples
 
@@ -101,7 +102,7 @@ int run_bench_equal_error(const BenchArgs& a) {
         p.spp = spp;
         auto t0 = std::chrono::steady_clock::now();
         std::vector<float> img = render_path<3>(*fit.scene, rgb_spectra, o).develop();
-        for (float& v : img) v = display_value(v, fit.ref_tone);
+        for (float& v : img) v = pipeline::display_value(v, fit.ref_tone);
         p.render_s = seconds_since(t0);
         t0 = std::chrono::steady_clock::now();
         std::vector<float> latent = vae->encode(img, W, H);

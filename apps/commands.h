@@ -1,6 +1,11 @@
 // Subcommand entry points. main.cpp owns all command-line parsing (one CLI11 translation unit);
 // each subcommand file receives plain option structs.
 #pragma once
+#include "pipeline/fit.h"
+#include "pipeline/paths.h"
+#include "pipeline/progress.h"
+#include "pipeline/refine.h"
+#include "pipeline/vae_source.h"
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -9,26 +14,14 @@
 
 namespace lpt {
 class Scene;
-class Vae;
-struct RefinerInput;
 }
 
 namespace lpt::app {
 
-/// Which autoencoder: TAESD3 weights in `dir` (native), or a TorchScript export (all three of
-/// encoder, decoder, config; tools/export_vae.py makes them for the SD3.5 VAE).
-struct VaeSource {
-    std::string dir;                       ///< empty = ../shared/models/taesd3 (LATENTPT_SHARED overrides)
-    std::string encoder, decoder, config;  ///< TorchScript modules and vae.json
-    bool torchscript() const { return !encoder.empty() || !decoder.empty() || !config.empty(); }
-};
-/// Loads the VAE; throws with the file name if it is missing or broken, or if only part of the
-/// TorchScript triple is given.
-std::unique_ptr<lpt::Vae> open_vae(const VaeSource& source);
-/// Whether open_vae can be expected to find its files (for "no VAE: latents only" fallbacks).
-bool vae_present(const VaeSource& source);
-/// The VAE a fit folder used (fit.json), with the defaults resolved.
-VaeSource manifest_vae(const std::string& fit_json_path);
+using pipeline::VaeSource;
+using pipeline::default_lpips_dir;
+using pipeline::default_vae_dir;
+using pipeline::shared_dir;
 
 struct RenderArgs {
     std::string scene;
@@ -73,42 +66,18 @@ int run_bench_fit(const BenchArgs& args);
 int run_bench_equal_error(const BenchArgs& args);
 int run_bench_equal_noise(const BenchArgs& args);
 
-/// Stage 2 on a fit folder: trains the refiner on the folder's final render (latent.exr, aov.exr)
-/// against target.exr (and reference_rgb.exr for LPIPS when present).
+/// `latentpt refine` and `latentpt fit`: the pipeline's jobs plus what only a terminal needs.
 struct RefineArgs {
-    std::string fitdir;
-    int iterations = 3000, expansion = 16, crop = 32, lpips_crop = 16, patience = 500, checkpoint_every = 100;
-    float lr = 5e-4f, w_mse = 1.f, w_ssim = 1.f, w_lpips = 1.f, squash = 3.f, dropout = 0.1f;
-    uint64_t seed = 0;
-    bool resume = false, quiet = false;
-    std::string lpips_dir;  ///< default: ../shared/models/lpips
+    pipeline::RefineJob job;
+    bool quiet = false;
 };
 int run_refine(const RefineArgs& args);
-/// The refiner's view of a rendered latent: AOVs (normal, distance) of `scene` at the latent's
-/// resolution, averaged over `spp` camera samples with `seed` (as the latent was rendered).
-RefinerInput refiner_view(const lpt::Scene& scene, std::vector<float> latent, int w, int h, int spp, uint64_t seed);
-/// aov.exr of a fit folder (channels N.X N.Y N.Z Z) and its reader (with latent.exr).
-void write_refiner_aovs(const std::string& path, const RefinerInput& in);
-RefinerInput load_refiner_input(const std::string& latent_exr, const std::string& aov_exr);
+/// "wrote ..." and the rendered / refined / VAE round-trip metrics of a finished stage 2.
+void print_refine_summary(const std::string& fitdir, const pipeline::RefineSummary& summary);
 
 struct FitArgs {
-    std::string scene, target, out = "fit-out";
-    std::string synthetic_res = "32x32";  ///< used when no --target is given
-    uint64_t synthetic_seed = 1;
-    int iterations = 3000, spp = 16, final_spp = 256;
-    uint64_t seed = 0;
-    float lr = 1e-3f, lr_min = 0.f, min_delta = 1e-5f;
-    int lr_period = 500, patience = 300, checkpoint_every = 100, reuse_paths = 8;
-    std::string tone = "clip", param = "code", gate = "shadowed", terms = "eac";
-    bool resume = false, quiet = false;
-    std::map<std::string, std::string> defines;
-    bool encode = false;          ///< target = VAE encoding of an RGB path trace of the scene
-    std::string encode_res = "256x256";  ///< image resolution for --encode (latent = image / 8)
-    int ref_spp = 256;
-    std::string ref_tone = "clip";       ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
-    VaeSource vae;
-    bool refiner = true;                 ///< run stage 2 after stage 1
-    RefineArgs refine;                   ///< stage-2 options (fitdir, seed, resume, quiet are filled in)
+    pipeline::FitJob job;
+    bool quiet = false;
 };
 int run_fit(const FitArgs& args);
 
@@ -139,24 +108,12 @@ struct CompareArgs {
 };
 int run_compare(const CompareArgs& a);
 
-/// The shared data folder: LATENTPT_SHARED, else ../shared beside the source tree.
-std::string shared_dir();
-/// ../shared (LATENTPT_SHARED overrides) + "/models/taesd3" unless `dir` is given.
-std::string default_vae_dir(const std::string& dir);
-/// ../shared (LATENTPT_SHARED overrides) + "/models/lpips" unless `dir` is given.
-std::string default_lpips_dir(const std::string& dir);
-/// The paper's display mapping for references: clip to [0, 1] (or |x|/(1+|x|) for "reinhard"),
-/// then x^(1/2.2).
-float display_value(float v, const std::string& tone);
-/// Path-traced RGB of `scene` at width x height, tone-mapped as the paper does for its
-/// references (clip or reinhard, then gamma 1/2.2), encoded by `vae`. `display_rgb`, if given,
-/// receives the tone-mapped RGB that was encoded.
-std::vector<float> encoded_reference_of(const lpt::Scene& scene, int width, int height, int spp, const std::string& tone,
-                                        const lpt::Vae& vae, bool quiet, const std::string& save_png,
-                                        std::vector<float>* display_rgb = nullptr);
-
 /// Parses "WxH"; throws std::invalid_argument with a clear message.
 void parse_resolution(const std::string& s, int& w, int& h);
+
+/// A pipeline reporter for the terminal: progress and notes on stderr (nothing when quiet, except
+/// warnings).
+pipeline::Reporter console_reporter(bool quiet);
 
 /// Prints "\r[label] 45.0% | 12.3 Mrays/s | ETA 3.2 s" to stderr, at most every 0.25 s.
 class Progress {

@@ -64,41 +64,42 @@ int main(int argc, char** argv) {
     bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")->capture_default_str()->check(CLI::PositiveNumber);
 
     FitArgs f;
+    std::string fit_tone = to_string(f.job.options.tone);  // the library's default, shown by --help
     std::vector<std::string> fit_defines;
     auto* fit = app.add_subcommand("fit", "fit per-shape latent parameters to a target latent map (stage 1)");
-    fit->add_option("scene", f.scene, "scene file (.json or Mitsuba 3 .xml)")->required()->check(CLI::ExistingFile);
-    fit->add_option("--target", f.target, "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
+    fit->add_option("scene", f.job.scene, "scene file (.json or Mitsuba 3 .xml)")->required()->check(CLI::ExistingFile);
+    fit->add_option("--target", f.job.target, "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
                                           "without it, a synthetic target rendered from random parameters")->check(CLI::ExistingFile);
-    fit->add_option("-o,--out", f.out, "output folder")->capture_default_str();
-    fit->add_option("--synthetic-res", f.synthetic_res, "latent resolution WxH of the synthetic target")->capture_default_str();
-    fit->add_option("--synthetic-seed", f.synthetic_seed, "seed of the synthetic target's parameters")->capture_default_str();
-    fit->add_option("--iterations", f.iterations, "optimiser steps")->capture_default_str();
-    fit->add_option("--spp", f.spp, "samples per pixel per iteration")->capture_default_str();
-    fit->add_option("--final-spp", f.final_spp, "samples per pixel of the final render")->capture_default_str();
-    fit->add_option("--seed", f.seed, "seed of the initial parameters and of every iteration's paths")->capture_default_str();
-    fit->add_option("--lr", f.lr, "Adam learning rate (cosine annealing with warm restarts)")->capture_default_str();
-    fit->add_option("--lr-min", f.lr_min, "minimum learning rate of the schedule")->capture_default_str();
-    fit->add_option("--lr-period", f.lr_period, "iterations per restart period")->capture_default_str();
-    fit->add_option("--patience", f.patience, "early stopping: iterations without improvement of the smoothed loss; 0 = off")->capture_default_str();
-    fit->add_option("--min-delta", f.min_delta, "early stopping: smallest improvement that counts")->capture_default_str();
-    fit->add_option("--tone", f.tone, "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
+    fit->add_option("-o,--out", f.job.out, "output folder")->capture_default_str();
+    fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")->capture_default_str();
+    fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")->capture_default_str();
+    fit->add_option("--iterations", f.job.options.iterations, "optimiser steps")->capture_default_str();
+    fit->add_option("--spp", f.job.options.spp, "samples per pixel per iteration")->capture_default_str();
+    fit->add_option("--final-spp", f.job.final_spp, "samples per pixel of the final render")->capture_default_str();
+    fit->add_option("--seed", f.job.options.seed, "seed of the initial parameters and of every iteration's paths")->capture_default_str();
+    fit->add_option("--lr", f.job.options.lr, "Adam learning rate (cosine annealing with warm restarts)")->capture_default_str();
+    fit->add_option("--lr-min", f.job.options.lr_min, "minimum learning rate of the schedule")->capture_default_str();
+    fit->add_option("--lr-period", f.job.options.lr_period, "iterations per restart period")->capture_default_str();
+    fit->add_option("--patience", f.job.options.patience, "early stopping: iterations without improvement of the smoothed loss; 0 = off")->capture_default_str();
+    fit->add_option("--min-delta", f.job.options.min_delta, "early stopping: smallest improvement that counts")->capture_default_str();
+    fit->add_option("--tone", fit_tone, "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
         ->check(CLI::IsMember({"clip", "reinhard", "logit"}))->capture_default_str();
-    fit->add_option("--param", f.param, "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
+    fit->add_option("--param", f.job.param, "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
         ->check(CLI::IsMember({"code", "paper", "classic"}))->capture_default_str();
-    fit->add_option("--gate", f.gate, "Ic gate: shadowed (1 - V) or visible (V)")->check(CLI::IsMember({"shadowed", "visible"}))->capture_default_str();
-    fit->add_option("--terms", f.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
-    fit->add_option("--checkpoint-every", f.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();
-    fit->add_option("--reuse-paths", f.reuse_paths,
+    fit->add_option("--gate", f.job.gate, "Ic gate: shadowed (1 - V) or visible (V)")->check(CLI::IsMember({"shadowed", "visible"}))->capture_default_str();
+    fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
+    fit->add_option("--checkpoint-every", f.job.options.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();
+    fit->add_option("--reuse-paths", f.job.options.reuse_paths,
                     "K: trace and store one frame of paths every K iterations and replay them in between (no rays; ~56 bytes per path event, "
                     "~140 MB at 128x128 latents x 16 spp); 0: fresh paths every iteration, re-traced for the gradient (least memory). "
                     "Equal final loss for K = 0, 1, 8, 32 on the CBox (docs/fitting.md)")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    fit->add_flag("--resume", f.resume, "continue from <out>/checkpoint");
-    fit->add_flag("--encode", f.encode, "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
-    fit->add_option("--encode-res", f.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")->capture_default_str();
-    fit->add_option("--ref-spp", f.ref_spp, "samples per pixel of the RGB reference for --encode")->capture_default_str();
-    fit->add_option("--ref-tone", f.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
+    fit->add_flag("--resume", f.job.resume, "continue from <out>/checkpoint");
+    fit->add_flag("--encode", f.job.encode, "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
+    fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")->capture_default_str();
+    fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")->capture_default_str();
+    fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
     // The autoencoder: native TAESD3 weights, or any VAE exported to TorchScript (tools/export_vae.py).
     auto vae_options = [](CLI::App* sc, VaeSource& vs) {
         sc->add_option("--vae-dir", vs.dir, "TAESD3 weights folder, <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
@@ -106,34 +107,34 @@ int main(int argc, char** argv) {
         sc->add_option("--vae-decoder", vs.decoder, "TorchScript decoder module")->check(CLI::ExistingFile);
         sc->add_option("--vae-config", vs.config, "vae.json of the TorchScript VAE: channels, downsample, scale, shift, image_range, latent")->check(CLI::ExistingFile);
     };
-    vae_options(fit, f.vae);
+    vae_options(fit, f.job.vae);
     fit->add_option("-D,--define", fit_defines, "override a scene value (as for render)");
-    fit->add_flag("!--no-refiner", f.refiner, "stop after stage 1 (no refiner training)");
+    fit->add_flag("!--no-refiner", f.job.refiner, "stop after stage 1 (no refiner training)");
     fit->add_flag("-q,--quiet", f.quiet, "no progress line");
 
     // Stage-2 options: `--refiner-<name>` on fit, `--<name>` on refine.
-    auto refine_options = [](CLI::App* sc, RefineArgs& ra, const std::string& pre) {
-        sc->add_option("--" + pre + "iterations", ra.iterations, "refiner training steps")->capture_default_str();
-        sc->add_option("--" + pre + "expansion", ra.expansion, "refiner width = expansion x 16 channels")->capture_default_str();
-        sc->add_option("--" + pre + "crop", ra.crop, "latent crop side per refiner step (0 = the whole view)")->capture_default_str();
-        sc->add_option("--" + pre + "lpips-crop", ra.lpips_crop, "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")->capture_default_str();
-        sc->add_option("--" + pre + "lr", ra.lr, "refiner Adam learning rate")->capture_default_str();
-        sc->add_option("--" + pre + "patience", ra.patience, "refiner early stopping on the smoothed loss; 0 = off")->capture_default_str();
-        sc->add_option("--" + pre + "w-mse", ra.w_mse, "weight of latent MSE")->capture_default_str();
-        sc->add_option("--" + pre + "w-ssim", ra.w_ssim, "weight of latent 1 - SSIM")->capture_default_str();
-        sc->add_option("--" + pre + "w-lpips", ra.w_lpips, "weight of LPIPS on decoded crops")->capture_default_str();
-        sc->add_option("--" + pre + "squash", ra.squash, "inputs enter as tanh(x / squash)")->capture_default_str();
-        sc->add_option("--" + pre + "dropout", ra.dropout, "dropout after each block")->capture_default_str();
-        sc->add_option("--" + pre + "checkpoint-every", ra.checkpoint_every, "refiner steps between checkpoints")->capture_default_str();
+    auto refine_options = [](CLI::App* sc, lpt::pipeline::RefineJob& ra, const std::string& pre) {
+        sc->add_option("--" + pre + "iterations", ra.train.iterations, "refiner training steps")->capture_default_str();
+        sc->add_option("--" + pre + "expansion", ra.net.expansion, "refiner width = expansion x 16 channels")->capture_default_str();
+        sc->add_option("--" + pre + "crop", ra.train.crop, "latent crop side per refiner step (0 = the whole view)")->capture_default_str();
+        sc->add_option("--" + pre + "lpips-crop", ra.train.lpips_crop, "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")->capture_default_str();
+        sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")->capture_default_str();
+        sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")->capture_default_str();
+        sc->add_option("--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE")->capture_default_str();
+        sc->add_option("--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM")->capture_default_str();
+        sc->add_option("--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops")->capture_default_str();
+        sc->add_option("--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)")->capture_default_str();
+        sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")->capture_default_str();
+        sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")->capture_default_str();
         sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
     };
-    refine_options(fit, f.refine, "refiner-");
+    refine_options(fit, f.job.refine, "refiner-");
     RefineArgs rf;
     auto* refine = app.add_subcommand("refine", "train the per-scene refiner on a fit folder (stage 2; fit runs it unless --no-refiner)");
-    refine->add_option("fitdir", rf.fitdir, "folder written by latentpt fit")->required()->check(CLI::ExistingDirectory);
-    refine_options(refine, rf, "");
-    refine->add_option("--seed", rf.seed, "seed of the initial weights, crops and dropout")->capture_default_str();
-    refine->add_flag("--resume", rf.resume, "continue from <fitdir>/refiner_checkpoint.pt");
+    refine->add_option("fitdir", rf.job.fitdir, "folder written by latentpt fit")->required()->check(CLI::ExistingDirectory);
+    refine_options(refine, rf.job, "");
+    refine->add_option("--seed", rf.job.train.seed, "seed of the initial weights, crops and dropout")->capture_default_str();
+    refine->add_flag("--resume", rf.job.resume, "continue from <fitdir>/refiner_checkpoint.pt");
     refine->add_flag("-q,--quiet", rf.quiet, "no progress line");
 
     VaeArgs v;
@@ -208,10 +209,10 @@ int main(int argc, char** argv) {
             for (const auto& d : fit_defines) {
                 auto eq = d.find('=');
                 if (eq == std::string::npos) throw std::invalid_argument("-D expects key=value, got '" + d + "'");
-                f.defines[d.substr(0, eq)] = d.substr(eq + 1);
+                f.job.defines[d.substr(0, eq)] = d.substr(eq + 1);
             }
-            if (f.terms.find_first_not_of("eac") != std::string::npos || f.terms.empty())
-                throw std::invalid_argument("--terms takes letters from e, a, c; got '" + f.terms + "'");
+            f.job.options.tone = lpt::parse_tone_curve(fit_tone);
+            lpt::pipeline::validate(f.job);
             return run_fit(f);
         }
     } catch (const std::exception& e) {

@@ -27,7 +27,8 @@ struct FitOptions {
     /// wavefront). K >= 1: trace and store one frame's paths every K iterations and replay the
     /// stored paths (forward and adjoint) in between: no rays traced, memory ~56 B per event
     /// (docs/path-replay.md (6), measured in docs/performance.md).
-    int reuse_paths = 0;
+    /// The default, 8, is what `latentpt fit` uses (one source: the CLI shows this value).
+    int reuse_paths = 8;
     int checkpoint_every = 100;   ///< 0 = never; rounded up to a multiple of reuse_paths
     std::string checkpoint_dir;   ///< empty = no checkpoints
 };

@@ -7,11 +7,41 @@
 
 namespace lpt::test {
 
+namespace {
+
+/// latentpt-test-<pid> in the system's temp folder, removed at process exit.
+class ProcessTempDir {
+public:
+    ProcessTempDir() : m_path(std::filesystem::temp_directory_path() / ("latentpt-test-" + std::to_string(::getpid()))) {}
+    ~ProcessTempDir() {
+        std::error_code ignored;
+        std::filesystem::remove_all(m_path, ignored);
+    }
+    const std::filesystem::path& path() const { return m_path; }
+
+private:
+    std::filesystem::path m_path;
+};
+
+const std::filesystem::path& process_temp_dir() {
+    static const ProcessTempDir dir;
+    std::filesystem::create_directories(dir.path());
+    return dir.path();
+}
+
+}  // namespace
+
+std::string temp_dir(const std::string& name) {
+    namespace fs = std::filesystem;
+    const fs::path p = process_temp_dir() / name;
+    fs::remove_all(p);
+    fs::create_directories(p);
+    return p.string();
+}
+
 std::string write_temp_file(const std::string& name, const std::string& contents) {
     namespace fs = std::filesystem;
-    fs::path dir = fs::temp_directory_path() / ("latentpt-test-" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    fs::path p = dir / name;
+    fs::path p = process_temp_dir() / name;
     fs::create_directories(p.parent_path());
     std::ofstream(p, std::ios::binary) << contents;
     return p.string();

@@ -35,6 +35,7 @@ FitOptions fit_options(int iterations) {
     o.lr = 0.05f;  // small problem, few iterations: the paper's 1e-3 would need thousands
     o.lr_period = iterations;
     o.patience = 0;
+    o.reuse_paths = 0;  // fresh paths every iteration unless a test says otherwise
     return o;
 }
 

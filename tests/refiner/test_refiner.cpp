@@ -61,9 +61,7 @@ RefinerConfig small() {
 }
 
 std::string temp_path(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / ("lpt_refiner_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return (dir / name).string();
+    return test::write_temp_file(name, "");
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ const std::string& exported_dir() {
     static std::string dir = [] {
         const std::string shared = test::shared_dir(), py = python_with_torch();
         if (shared.empty() || py.empty()) return std::string();
-        const fs::path out = fs::temp_directory_path() / ("lpt_ts_" + std::to_string(::getpid()));
+        const fs::path out = test::temp_dir("torchscript-taesd3");
         const std::string cmd = py + " " LPT_SOURCE_DIR "/tools/export_taesd3.py --weights " + shared + "/models/taesd3 --out " + out.string() + " >/dev/null";
         if (std::system(cmd.c_str()) != 0) return std::string("FAILED");
         return out.string();
@@ -100,8 +100,7 @@ TEST(TorchScriptVae, RawLatentsAndSignedRangeAreMappedBack) {
 }
 
 TEST(TorchScriptVae, BadFilesAndConfigsNameTheProblem) {
-    const fs::path d = fs::temp_directory_path() / ("lpt_ts_bad_" + std::to_string(::getpid()));
-    fs::create_directories(d);
+    const fs::path d = test::temp_dir("torchscript-bad");
     auto expect_error = [](const std::string& enc, const std::string& dec, const std::string& cfg, const std::string& needle) {
         try {
             load_torchscript_vae(enc, dec, cfg);

@@ -1,0 +1,185 @@
+#include "pipeline/edit.h"
+#include "autodiff/fit.h"
+#include "autodiff/loss.h"
+#include "core/image_io.h"
+#include "core/scene_edit.h"
+#include "pipeline/fit_folder.h"
+#include "pipeline/paths.h"
+#include "pipeline/reference.h"
+#include "pipeline/refiner_io.h"
+#include "refiner/refiner.h"
+#include "vae/lpips.h"
+#include "vae/ssim.h"
+#include "vae/vae.h"
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace lpt::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* const kMetricColumns = "latent_mse,latent_psnr,latent_dssim,rgb_mse_x100,rgb_ssim,rgb_lpips";
+
+/// What the frames are refined, decoded and judged with; each is optional.
+struct Tools {
+    std::unique_ptr<Refiner> refiner;
+    std::unique_ptr<Vae> vae;
+    std::unique_ptr<Lpips> lpips;
+};
+
+Tools open_tools(const EditJob& job, const FitFolder& fit, const Reporter& report) {
+    const fs::path dir(job.fitdir);
+    const bool have_vae = vae_present(fit.vae);
+    if (job.reference && !have_vae)
+        throw std::runtime_error("--reference needs the fit's VAE to encode references; not found: " + default_vae_dir(fit.vae.dir));
+    if (!have_vae) report.say("note: the fit's VAE is not here (" + default_vae_dir(fit.vae.dir) + "): writing latents only");
+    Tools t;
+    // Stage 2, when the fit trained one: every frame is refined from its latent and AOVs.
+    if (fs::exists(dir / "refiner.pt")) t.refiner = Refiner::load((dir / "refiner.pt").string());
+    else report.say("note: " + (dir / "refiner.pt").string() + " not found: frames are not refined");
+    if (have_vae) t.vae = open_vae(fit.vae);
+    if (job.reference && have_vae) {
+        const std::string lpips_dir = default_lpips_dir("");
+        if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) t.lpips = Lpips::load(lpips_dir);
+        else report.say("note: no LPIPS weights at " + lpips_dir + ": rgb_lpips left empty");
+    }
+    return t;
+}
+
+std::string metrics_header(bool refined) {
+    std::string header = std::string("frame,t,") + kMetricColumns;
+    if (!refined) return header;
+    const std::string c = kMetricColumns;
+    for (size_t p = 0, q; p <= c.size(); p = q + 1) {
+        q = c.find(',', p);
+        if (q == std::string::npos) q = c.size();
+        header += ",refined_" + c.substr(p, q - p);
+    }
+    return header;
+}
+
+/// One frame's errors against the encoded reference (docs/metrics.md): latent MSE, PSNR over the
+/// data range 6, D-SSIM = 1 − SSIM (range 6); decoded RGB (clamped to [0, 1]) MSE × 100, SSIM,
+/// LPIPS against the display-mapped reference. Empty where the image is below a metric's size.
+std::string frame_metrics(const std::vector<float>& latent, const std::vector<float>& ref, const std::vector<float>& ref_rgb, int w, int h,
+                          const Tools& t) {
+    const double mse = mse_loss(latent.data(), ref.data(), ref.size());
+    std::ostringstream o;
+    o << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12)) << ",";  // data range 6 (±3)
+    if (w >= kSsimWindow && h >= kSsimWindow) o << 1.0 - ssim(latent.data(), ref.data(), w, h, kLatentChannels, kLatentDataRange);
+    o << ",";
+    if (!t.vae) {
+        o << ",,";
+        return o.str();
+    }
+    std::vector<float> rgb = t.vae->decode(latent, w, h);
+    for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+    o << 100.0 * mse_loss(rgb.data(), ref_rgb.data(), rgb.size()) << ",";
+    if (8 * w >= kSsimWindow && 8 * h >= kSsimWindow) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
+    o << ",";
+    if (t.lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) o << t.lpips->distance(rgb, ref_rgb, 8 * w, 8 * h);
+    return o.str();
+}
+
+/// The encoded reference of the edited frame and its display RGB. The edited scene file is not on
+/// disk: path trace this Scene directly, or take the frame from the cache (experiments compare
+/// several fits on one sequence).
+std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, const Tools& t, const std::string& frame,
+                                   const std::string& stem, int w, int h, std::vector<float>& ref_rgb) {
+    fs::path cached;
+    if (!job.reference_cache.empty()) {
+        char key[160];
+        std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s.exr", fs::path(job.edits).stem().string().c_str(), 8 * w, 8 * h, job.ref_spp,
+                      fit.ref_tone.c_str(), frame.c_str());
+        cached = fs::path(job.reference_cache) / key;
+    }
+    if (!cached.empty() && fs::exists(cached)) {
+        Image img = read_image(cached.string());
+        if (img.width != 8 * w || img.height != 8 * h || img.channels != 3)
+            throw std::runtime_error(cached.string() + ": cached reference has the wrong size");
+        ref_rgb = img.data;
+        write_png_display(stem + "_reference.png", Image{8 * w, 8 * h, 3, ref_rgb, {}});
+        return t.vae->encode(ref_rgb, 8 * w, 8 * h);
+    }
+    std::vector<float> ref = encoded_reference_of(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae, stem + "_reference.png", &ref_rgb);
+    if (!cached.empty()) {
+        fs::create_directories(cached.parent_path());
+        write_exr(cached.string(), Image{8 * w, 8 * h, 3, ref_rgb, {"R", "G", "B"}});
+    }
+    return ref;
+}
+
+/// Renders, refines and decodes frame `i` (the scene already edited); returns its metrics row
+/// (empty without job.reference).
+std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& t, int i, float time, int w, int h, const fs::path& out) {
+    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
+    ro.width = w;
+    ro.height = h;
+    ro.spp = job.spp;
+    ro.seed = job.seed + uint64_t(i);
+    std::vector<float> latent = render_toned(*fit.model, ro, fit.tone), refined;
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%04d", i);
+    const std::string stem = (out / name).string();
+    write_latent(stem + "_latent.exr", w, h, latent);
+    if (t.refiner) {
+        // Same spp and seed as the latent: an identity edit reproduces the fit's refined latent.
+        const RefinerInput view = refiner_view(*fit.scene, latent, w, h, ro.spp, ro.seed);
+        write_refiner_aovs(stem + "_aov.exr", view);
+        refined = t.refiner->refine(view);
+        write_latent(stem + "_refined.exr", w, h, refined);
+    }
+    if (t.vae) {
+        // frame_NNNN.png is the result (refined when there is a refiner); _rendered.png the unrefined one.
+        write_png_display(stem + (t.refiner ? "_rendered.png" : ".png"), Image{8 * w, 8 * h, 3, t.vae->decode(latent, w, h), {}});
+        if (t.refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, t.vae->decode(refined, w, h), {}});
+    }
+    if (!job.reference) return {};
+    std::vector<float> ref_rgb;
+    const std::vector<float> ref = frame_reference(job, fit, t, name, stem, w, h, ref_rgb);
+    std::ostringstream row;
+    row << i << "," << time << frame_metrics(latent, ref, ref_rgb, w, h, t);
+    if (t.refiner) row << frame_metrics(refined, ref, ref_rgb, w, h, t);
+    return row.str();
+}
+
+}  // namespace
+
+int render_edits(const EditJob& job, const Reporter& report) {
+    if (!fs::is_directory(job.fitdir)) throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
+    FitFolder fit = load_fit_folder(job.fitdir, job.defines);
+    Scene& scene = *fit.scene;
+    const int w = job.width > 0 ? job.width : fit.latent_width, h = job.height > 0 ? job.height : fit.latent_height;
+    const EditSequence edits = load_edits(job.edits, scene);
+    std::vector<TriangleMesh> original;
+    for (const Shape& s : scene.shapes) original.push_back(s.mesh);
+    const Camera original_camera = scene.camera;
+    const Tools tools = open_tools(job, fit, report);
+    const fs::path out(job.out);
+    fs::create_directories(out);
+    std::ostringstream csv;
+    csv << metrics_header(tools.refiner != nullptr) << "\n";
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < edits.frames; ++i) {
+        const float t = float(i) / float(edits.frames);
+        apply_edits(edits, t, original, original_camera, scene);
+        const std::string row = render_frame(job, fit, tools, i, t, w, h, out);
+        if (job.reference) csv << row << "\n";
+        StageProgress p;
+        p.stage = "edit";
+        p.step = i + 1;
+        p.total = edits.frames;
+        p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!report.step(p)) throw Cancelled("edit");
+    }
+    if (job.reference) write_text_atomic((out / "metrics.csv").string(), csv.str());
+    return edits.frames;
+}
+
+}  // namespace lpt::pipeline

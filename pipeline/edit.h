@@ -1,0 +1,28 @@
+// Edited views of a fitted latent scene as a library call: camera / shape edits frame by frame,
+// each frame's latent (tone-mapped, what the VAE reads), refined latent and AOVs when the fit has
+// a refiner, decoded PNGs when its VAE is here, and with `reference` the RGB path trace of the
+// same edit encoded by the VAE and per-frame errors in metrics.csv (docs/metrics.md).
+#pragma once
+#include "pipeline/progress.h"
+#include <cstdint>
+#include <map>
+#include <string>
+
+namespace lpt::pipeline {
+
+struct EditJob {
+    std::string fitdir, edits;                   ///< fit folder, edits.json
+    std::string out = "edit-out";                ///< output folder
+    std::map<std::string, std::string> defines;  ///< override the fit's -D values
+    int width = 0, height = 0;                   ///< latent resolution; 0 = the fit's
+    int spp = 64;
+    uint64_t seed = 0;                           ///< frame i uses seed + i
+    bool reference = false;
+    int ref_spp = 256;
+    std::string reference_cache;                 ///< keeps path-traced reference frames for reuse
+};
+
+/// Returns the number of frames written. Throws Cancelled when the reporter cancels.
+int render_edits(const EditJob& job, const Reporter& report = {});
+
+}  // namespace lpt::pipeline

@@ -1,0 +1,224 @@
+#include "pipeline/fit.h"
+#include "autodiff/loss.h"
+#include "core/image_io.h"
+#include "core/latent_viz.h"
+#include "core/scene_loader.h"
+#include "pipeline/fit_folder.h"
+#include "pipeline/reference.h"
+#include "pipeline/refiner_io.h"
+#include "vae/vae.h"
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace lpt::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Target {
+    std::vector<float> data;
+    int width = 0, height = 0;  ///< latent resolution
+};
+
+void parse_dimension(const std::string& s, int& w, int& h) {
+    char x = 0;
+    int a = 0, b = 0;
+    if (std::sscanf(s.c_str(), "%d%c%d", &a, &x, &b) != 3 || (x != 'x' && x != 'X') || a < 1 || b < 1)
+        throw std::invalid_argument("expected a resolution WxH with positive integers, got '" + s + "'");
+    w = a;
+    h = b;
+}
+
+Target load_target_exr(const std::string& path) {
+    Image img = read_image(path);
+    if (img.channels != kLatentChannels)
+        throw std::runtime_error(path + ": target has " + std::to_string(img.channels) + " channels, a latent map needs " +
+                                 std::to_string(kLatentChannels) + " (an RGB image needs --encode)");
+    size_t bad = 0;
+    if (!check_finite(img.data.data(), img.data.size(), &bad))
+        throw std::runtime_error(path + ": value at pixel (" + std::to_string(bad / kLatentChannels % img.width) + ", " +
+                                 std::to_string(bad / kLatentChannels / img.width) + "), channel " +
+                                 std::to_string(bad % kLatentChannels) + " is not finite");
+    return {img.data, img.width, img.height};
+}
+
+/// The paper's target: path-traced RGB, display-mapped, encoded by the VAE. The RGB is kept as
+/// reference_rgb.exr: the refiner's LPIPS and metrics.json compare decoded latents with it.
+Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, const Reporter& report) {
+    int iw = 0, ih = 0;
+    parse_dimension(job.encode_res, iw, ih);
+    const fs::path out(job.out);
+    std::vector<float> ref_rgb;
+    Target t;
+    t.data = encoded_reference_of(scene, iw, ih, job.ref_spp, job.ref_tone, vae, (out / "reference.png").string(), &ref_rgb, report);
+    write_exr((out / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}});
+    t.width = iw / 8;
+    t.height = ih / 8;
+    return t;
+}
+
+/// A target the latent renderer makes itself from random parameters: for trying the fit without
+/// a VAE, and the test suite's convergence check.
+Target synthetic_target(const FitJob& job, const Scene& scene) {
+    Target t;
+    parse_dimension(job.synthetic_res, t.width, t.height);
+    LatentModel truth(scene, parameterisation_from_string(job.param), job.synthetic_seed);
+    RenderOptions ro = RenderOptions::from_scene(scene);
+    ro.width = t.width;
+    ro.height = t.height;
+    ro.spp = job.final_spp;
+    ro.seed = job.synthetic_seed;
+    t.data = render_toned(truth, ro, job.options.tone);
+    return t;
+}
+
+std::string loss_csv(const FitState& st) {
+    std::ostringstream out;
+    out << "iteration,loss,smoothed_loss,lr,seconds\n";
+    for (const FitRecord& r : st.history) out << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.lr << "," << r.seconds << "\n";
+    return out.str();
+}
+
+std::string fit_status(const FitRecord& r) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "loss %.5f (smoothed %.5f) | lr %.2e", r.loss, r.smoothed, r.lr);
+    return buf;
+}
+
+/// Runs the optimiser from `state`, reporting every iteration; false when the reporter cancelled.
+bool optimise(LatentModel& model, const Target& target, const FitOptions& o, FitState& state, const Reporter& report) {
+    const int start = state.next_iteration;
+    const double seconds_at_start = state.history.empty() ? 0.0 : state.history.back().seconds;
+    bool cancelled = false;
+    auto on_iteration = [&](const FitRecord& r, const FitState& st) {
+        if (r.refused && st.skipped_steps <= 10)
+            report.say("warning: iteration " + std::to_string(r.iteration) + ": non-finite gradient, step skipped (" +
+                       std::to_string(st.skipped_steps) + " so far)" + (st.skipped_steps == 10 ? "; further warnings suppressed" : ""));
+        StageProgress p;
+        p.stage = "fit";
+        p.step = r.iteration + 1;
+        p.total = o.iterations;
+        p.start = start;
+        p.seconds = r.seconds - seconds_at_start;
+        p.status = fit_status(r);
+        cancelled = !report.step(p);
+        return !cancelled;
+    };
+    state = fit_latent(model, target.data, target.width, target.height, o, state, on_iteration);
+    return !cancelled;
+}
+
+void write_latent_pictures(const fs::path& out, const Target& target, const std::vector<float>& toned) {
+    const int w = target.width, h = target.height;
+    std::vector<float> diff(toned.size());
+    for (size_t i = 0; i < toned.size(); ++i) diff[i] = toned[i] - target.data[i];
+    float scale = 0.f;
+    for (float v : target.data) scale = std::max(scale, std::abs(v));
+    write_png_srgb((out / "target.png").string(), latent_grid(target.data.data(), w, h, kLatentChannels, scale));
+    write_png_srgb((out / "render.png").string(), latent_grid(toned.data(), w, h, kLatentChannels, scale));
+    write_png_srgb((out / "diff.png").string(), latent_grid(diff.data(), w, h, kLatentChannels, scale));
+}
+
+/// What a person looks at: the fitted latent decoded to RGB next to the decoded target.
+void write_decoded(const fs::path& out, const Vae& vae, const Target& target, const std::vector<float>& toned) {
+    const int f = vae.convention().downsample, w = target.width, h = target.height;
+    write_png_display((out / "decoded.png").string(), Image{w * f, h * f, 3, vae.decode(toned, w, h), {"R", "G", "B"}});
+    write_png_display((out / "target_decoded.png").string(), Image{w * f, h * f, 3, vae.decode(target.data, w, h), {"R", "G", "B"}});
+}
+
+/// The final render of the best parameters at final_spp and everything stage 2 and `render
+/// --edit` read: params.json, fit.json, latent*.exr, aov.exr, loss.csv, pictures.
+double write_stage1(const FitJob& job, const LatentModel& model, const Target& target, const FitState& state, const Vae* vae) {
+    const fs::path out(job.out);
+    const int w = target.width, h = target.height;
+    RenderOptions ro = RenderOptions::from_scene(model.scene());
+    ro.width = w;
+    ro.height = h;
+    ro.spp = job.final_spp;
+    ro.seed = job.options.seed + 1;
+    TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro);
+    std::vector<float> linear = films.sum(), toned(linear.size());
+    tone_map(job.options.tone, linear.data(), toned.data(), linear.size());
+    const double final_loss = huber_loss(toned.data(), target.data.data(), toned.size(), 1.f, nullptr);
+    write_text_atomic((out / "params.json").string(), model.params().to_json());
+    write_text_atomic((out / "fit.json").string(), fit_manifest(job, w, h, final_loss, state).dump(2));
+    write_latent((out / "latent.exr").string(), w, h, toned);
+    // AOVs of the same view with the same samples: what the refiner reads beside the latent.
+    write_refiner_aovs((out / "aov.exr").string(), refiner_view(model.scene(), toned, w, h, ro.spp, ro.seed));
+    write_latent((out / "latent_e.exr").string(), w, h, films.e.develop());
+    write_latent((out / "latent_a.exr").string(), w, h, films.a.develop());
+    write_latent((out / "latent_c.exr").string(), w, h, films.c.develop());
+    write_text_atomic((out / "loss.csv").string(), loss_csv(state));
+    write_latent_pictures(out, target, toned);
+    if (vae) write_decoded(out, *vae, target, toned);
+    return final_loss;
+}
+
+std::string stage1_summary(const FitState& state) {
+    char buf[160];
+    // With patience 0 nothing tracks a best iteration: the last parameters are kept.
+    if (state.best_iteration >= 0)
+        std::snprintf(buf, sizeof buf, "[fit] best smoothed loss %.5f at iteration %d; %d refused steps", state.best_loss,
+                      state.best_iteration, state.skipped_steps);
+    else
+        std::snprintf(buf, sizeof buf, "[fit] early stopping off: the last iteration's parameters are kept; %d refused steps",
+                      state.skipped_steps);
+    return buf;
+}
+
+}  // namespace
+
+void validate(const FitJob& job) {
+    if (job.terms.empty() || job.terms.find_first_not_of("eac") != std::string::npos)
+        throw std::invalid_argument("--terms takes letters from e, a, c; got '" + job.terms + "'");
+    parameterisation_from_string(job.param);
+    if (job.gate != "shadowed" && job.gate != "visible")
+        throw std::invalid_argument("--gate is shadowed or visible, got '" + job.gate + "'");
+    if (job.ref_tone != "clip" && job.ref_tone != "reinhard")
+        throw std::invalid_argument("--ref-tone is clip or reinhard, got '" + job.ref_tone + "'");
+}
+
+FitSummary run_fit(const FitJob& job, const Reporter& report) {
+    validate(job);
+    const Scene scene = load_scene(job.scene, job.defines);
+    LatentModel model(scene, parameterisation_from_string(job.param), job.options.seed);
+    configure_terms(model, job.gate, job.terms);
+    FitOptions o = job.options;
+    o.checkpoint_dir = (fs::path(job.out) / "checkpoint").string();
+
+    fs::create_directories(job.out);
+    std::unique_ptr<Vae> vae;
+    if (job.encode) vae = open_vae(job.vae);
+    const Target target = !job.target.empty() ? load_target_exr(job.target)
+                          : job.encode        ? encoded_target(job, scene, *vae, report)
+                                              : synthetic_target(job, scene);
+    write_latent((fs::path(job.out) / "target.exr").string(), target.width, target.height, target.data);
+
+    FitSummary summary;
+    if (job.resume) {
+        summary.state = load_checkpoint(o.checkpoint_dir, model);
+        report.say("resuming at iteration " + std::to_string(summary.state.next_iteration));
+    }
+    if (!optimise(model, target, o, summary.state, report)) throw Cancelled("fit");
+    report.say(stage1_summary(summary.state));
+    save_checkpoint(o.checkpoint_dir, model, summary.state);
+    summary.latent_width = target.width;
+    summary.latent_height = target.height;
+    summary.final_loss = write_stage1(job, model, target, summary.state, vae.get());
+    report.say("wrote " + job.out + "/{params.json, latent*.exr, aov.exr, loss.csv, target|render|diff.png}; Huber loss at " +
+               std::to_string(job.final_spp) + " spp: " + std::to_string(summary.final_loss));
+    if (job.refiner) {
+        RefineJob r = job.refine;
+        r.fitdir = job.out;
+        r.train.seed = job.options.seed;
+        r.resume = job.resume;
+        summary.refined = run_refine(r, report);
+    }
+    return summary;
+}
+
+}  // namespace lpt::pipeline

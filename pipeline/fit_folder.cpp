@@ -1,0 +1,108 @@
+#include "pipeline/fit_folder.h"
+#include "core/scene_loader.h"
+#include "pipeline/fit.h"
+#include "pipeline/paths.h"
+#include <filesystem>
+
+namespace lpt::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json parse_json_file(const std::string& path) {
+    try {
+        return nlohmann::json::parse(read_file(path));
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(path + ": malformed: " + e.what());
+    }
+}
+
+void set_terms(LatentTerms<kLatentChannels>& t, const std::string& gate, const std::string& terms) {
+    t.gate = gate == "visible" ? OcclusionGate::Visible : OcclusionGate::Shadowed;
+    t.emission = terms.find('e') != std::string::npos;
+    t.ambient = terms.find('a') != std::string::npos;
+    t.occlusion = terms.find('c') != std::string::npos;
+}
+
+}  // namespace
+
+void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) { set_terms(model.terms(), gate, terms); }
+
+FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::string, std::string>& overrides) {
+    const fs::path dir(dir_name);
+    if (!fs::is_directory(dir)) throw std::runtime_error(dir_name + ": not a folder (expected a fit folder made by latentpt fit)");
+    const std::string manifest_path = (dir / "fit.json").string();
+    if (!fs::exists(manifest_path)) throw std::runtime_error(manifest_path + ": missing: not a latentpt fit folder");
+    FitFolder f;
+    f.dir = dir_name;
+    f.manifest = parse_json_file(manifest_path);
+    const nlohmann::json& m = f.manifest;
+    try {
+        std::map<std::string, std::string> defines = m.value("defines", std::map<std::string, std::string>{});
+        for (const auto& [k, v] : overrides) defines[k] = v;
+        f.scene = std::make_unique<Scene>(load_scene(m.at("scene").get<std::string>(), defines));
+        f.model = std::make_unique<LatentModel>(*f.scene, parameterisation_from_string(m.value("param", "code")), 0);
+        const std::string params_path = (dir / "params.json").string();
+        if (!fs::exists(params_path)) throw std::runtime_error(params_path + ": missing");
+        f.model->params().load_json(read_file(params_path), params_path);
+        configure_terms(*f.model, m.value("gate", "shadowed"), m.value("terms", "eac"));
+        f.model->sync();
+        f.tone = parse_tone_curve(m.value("tone", "clip"));
+        f.latent_width = m.at("latent_width");
+        f.latent_height = m.at("latent_height");
+        f.ref_tone = m.value("ref_tone", "clip");
+        f.vae = vae_source_of(m);
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(manifest_path + ": " + e.what());
+    }
+    return f;
+}
+
+nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, const FitState& state) {
+    const FitOptions& o = job.options;
+    nlohmann::json m = {{"scene", fs::absolute(job.scene).string()}, {"defines", job.defines}, {"param", job.param},
+                        {"gate", job.gate}, {"terms", job.terms}, {"tone", to_string(o.tone)}, {"latent_width", w},
+                        {"latent_height", h}, {"seed", o.seed}, {"vae_dir", default_vae_dir(job.vae.dir)},
+                        {"ref_tone", job.ref_tone}};
+    if (job.vae.torchscript())
+        m["vae_torchscript"] = {{"encoder", fs::absolute(job.vae.encoder).string()},
+                                {"decoder", fs::absolute(job.vae.decoder).string()},
+                                {"config", fs::absolute(job.vae.config).string()}};
+    // How stage 1 went, for comparing runs (e.g. --reuse-paths) without parsing logs.
+    m["stage1"] = {{"final_loss", final_loss}, {"final_spp", job.final_spp}, {"iterations_run", state.next_iteration},
+                   {"best_iteration", state.best_iteration},
+                   {"seconds", state.history.empty() ? 0.0 : state.history.back().seconds}, {"spp", o.spp},
+                   {"reuse_paths", o.reuse_paths}, {"skipped_steps", state.skipped_steps}};
+    return m;
+}
+
+VaeSource vae_source_of(const nlohmann::json& m) {
+    VaeSource s;
+    s.dir = m.value("vae_dir", default_vae_dir(""));
+    if (m.contains("vae_torchscript")) {
+        const auto& t = m["vae_torchscript"];
+        s.encoder = t.value("encoder", "");
+        s.decoder = t.value("decoder", "");
+        s.config = t.value("config", "");
+    }
+    return s;
+}
+
+VaeSource manifest_vae(const std::string& path) { return vae_source_of(parse_json_file(path)); }
+
+Image read_fit_image(const std::string& path, int channels, int w, int h) {
+    if (!fs::exists(path)) throw std::runtime_error(path + ": missing (run latentpt fit first)");
+    Image img = read_image(path);
+    if (img.channels != channels || (w > 0 && (img.width != w || img.height != h)))
+        throw std::runtime_error(path + ": expected " + (w > 0 ? std::to_string(w) + "x" + std::to_string(h) + "x" : std::string()) +
+                                 std::to_string(channels) + ", found " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                                 "x" + std::to_string(img.channels));
+    return img;
+}
+
+void write_latent(const std::string& path, int w, int h, const std::vector<float>& data) {
+    write_exr(path, Image{w, h, kLatentChannels, data, {}});
+}
+
+}  // namespace lpt::pipeline

@@ -1,0 +1,55 @@
+// A fit folder: what `latentpt fit` writes and everything after it reads. fit.json (the
+// manifest: scene, -D values, model choices, latent size, VAE) is written and read here only;
+// load_fit_folder rebuilds the fitted latent model from it and params.json.
+#pragma once
+#include "autodiff/tone_curve.h"
+#include "core/image_io.h"
+#include "core/scene.h"
+#include "latent/latent_model.h"
+#include "pipeline/vae_source.h"
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace lpt {
+struct FitState;
+}
+
+namespace lpt::pipeline {
+
+struct FitJob;
+
+struct FitFolder {
+    std::string dir;
+    nlohmann::json manifest;                 ///< fit.json
+    std::unique_ptr<Scene> scene;            ///< owned here: the model refers to it
+    std::unique_ptr<LatentModel> model;
+    ToneCurve tone = ToneCurve::Clip;
+    int latent_width = 0, latent_height = 0;
+    std::string ref_tone = "clip";
+    VaeSource vae;                           ///< the VAE the fit used
+};
+
+/// Throws std::runtime_error naming the file for a missing or malformed fit.json / params.json.
+/// `defines` override the fit's own -D values.
+FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, std::string>& defines = {});
+
+/// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac").
+void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
+
+/// fit.json of a finished stage 1: everything load_fit_folder needs, plus how the stage went.
+nlohmann::json fit_manifest(const FitJob& job, int latent_width, int latent_height, double final_loss, const lpt::FitState& state);
+
+/// The VAE recorded in a parsed fit.json (defaults resolved); manifest_vae reads the file.
+VaeSource vae_source_of(const nlohmann::json& manifest);
+VaeSource manifest_vae(const std::string& fit_json_path);
+
+/// An image of a fit folder with `channels` channels (and w x h when w > 0); throws naming the
+/// file when it is missing or differs.
+Image read_fit_image(const std::string& path, int channels, int w, int h);
+/// A 16-channel latent map as a float EXR (channels C00..C15).
+void write_latent(const std::string& path, int w, int h, const std::vector<float>& data);
+
+}  // namespace lpt::pipeline

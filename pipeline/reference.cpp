@@ -1,0 +1,41 @@
+#include "pipeline/reference.h"
+#include "core/image_io.h"
+#include "core/scene.h"
+#include "integrators/path.h"
+#include "vae/vae.h"
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace lpt::pipeline {
+
+float display_value(float v, const std::string& tone) {
+    v = tone == "reinhard" ? std::abs(v) / (1.f + std::abs(v)) : std::clamp(v, 0.f, 1.f);
+    return std::pow(v, 1.f / 2.2f);
+}
+
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const Vae& vae,
+                                        const std::string& save_png, std::vector<float>* display_rgb, const Reporter& report) {
+    const int f = vae.convention().downsample;
+    if (width % f || height % f)
+        throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) + " in both axes, got " +
+                                    std::to_string(width) + "x" + std::to_string(height));
+    SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
+    RenderOptions o = RenderOptions::from_scene(scene);
+    o.width = width;
+    o.height = height;
+    o.spp = spp;
+    o.seed = 0x5eed;
+    RenderStats st;
+    std::vector<float> rgb = render_path<3>(scene, spectra, o, &st).develop();
+    for (float& v : rgb) v = display_value(v, tone);
+    std::ostringstream msg;
+    msg << "reference: " << width << "x" << height << " at " << spp << " spp in " << st.seconds << " s";
+    report.say(msg.str());
+    if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
+    if (display_rgb) *display_rgb = rgb;
+    return vae.encode(rgb, width, height);
+}
+
+}  // namespace lpt::pipeline

@@ -1,0 +1,151 @@
+#include "pipeline/refine.h"
+#include "autodiff/loss.h"
+#include "core/image_io.h"
+#include "latent/latent.h"
+#include "pipeline/fit_folder.h"
+#include "pipeline/paths.h"
+#include "pipeline/refiner_io.h"
+#include "vae/lpips.h"
+#include "vae/vae.h"
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+namespace lpt::pipeline {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// What decoded latents are judged with and against: the fit's VAE and LPIPS when present, and
+/// the RGB reference when the fit encoded one, else the decoded target.
+struct Judges {
+    std::unique_ptr<Vae> vae;
+    std::unique_ptr<Lpips> lpips;
+    std::vector<float> ref_rgb;
+    bool path_traced = false;  ///< ref_rgb is reference_rgb.exr
+};
+
+Judges open_judges(const RefineJob& job, const Image& target, const Reporter& report) {
+    const fs::path dir(job.fitdir);
+    const VaeSource vae_source = manifest_vae((dir / "fit.json").string());
+    Judges j;
+    if (vae_present(vae_source)) j.vae = open_vae(vae_source);
+    const std::string lpips_dir = default_lpips_dir(job.lpips_dir);
+    if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) j.lpips = Lpips::load(lpips_dir);
+    if (!j.vae || !j.lpips)
+        report.say("note: no " + (j.vae ? "LPIPS weights in " + lpips_dir : "VAE (" + default_vae_dir(vae_source.dir) + ")") +
+                   ": refiner trains on latent MSE + SSIM only");
+    j.path_traced = fs::exists(dir / "reference_rgb.exr");
+    if (j.path_traced) j.ref_rgb = read_fit_image((dir / "reference_rgb.exr").string(), 3, 8 * target.width, 8 * target.height).data;
+    else if (j.vae) j.ref_rgb = j.vae->decode(target.data, target.width, target.height);
+    return j;
+}
+
+/// Distances enter scaled by the training view's mean hit distance, so a scene in millimetres and
+/// one in metres feed the network the same numbers.
+float mean_hit_distance(const RefinerInput& in) {
+    double sum = 0;
+    int n = 0;
+    for (float d : in.distance)
+        if (d > 0) sum += d, ++n;
+    return n ? float(sum / n) : 1.f;
+}
+
+/// RGB metrics of a decoded latent against the reference image (both in [0, 1] display values).
+nlohmann::json rgb_metrics(std::vector<float> rgb, const std::vector<float>& ref, int w, int h, const Lpips* lpips) {
+    for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
+    nlohmann::json j = {{"rgb_mse_x100", 100.0 * mse_loss(rgb.data(), ref.data(), rgb.size())}};
+    if (lpips && w >= Lpips::kMinSize && h >= Lpips::kMinSize) j["rgb_lpips"] = lpips->distance(rgb, ref, w, h);
+    return j;
+}
+
+double latent_mse(const std::vector<float>& a, const std::vector<float>& b) { return mse_loss(a.data(), b.data(), a.size()); }
+
+std::string refiner_csv(const RefinerTrainResult& res) {
+    std::ostringstream csv;
+    csv << "iteration,loss,smoothed_loss,mse,dssim,lpips,seconds\n";
+    for (const RefinerRecord& r : res.history)
+        csv << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.mse << "," << r.dssim << "," << r.lpips << "," << r.seconds << "\n";
+    return csv.str();
+}
+
+nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, const RefinerTrainResult& res) {
+    const double seconds = res.history.empty() ? 0.0 : res.history.back().seconds;
+    return {{"expansion", job.net.expansion}, {"parameters", refiner.parameter_count()}, {"iterations", res.history.size()},
+            {"best_iteration", res.best_iteration}, {"seconds", seconds},
+            {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
+            {"crop", job.train.crop}, {"lpips_crop", job.train.lpips_crop}};
+}
+
+/// metrics.json: latent MSE of the rendered and refined latents against the target, and with a
+/// VAE their decoded RGB errors and the VAE's own round trip; writes decoded_refined.png.
+nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vector<float>& refined, const Image& target,
+                     const Judges& j) {
+    nlohmann::json m = {{"rendered", {{"latent_mse", latent_mse(in.latent, target.data)}}},
+                        {"refined", {{"latent_mse", latent_mse(refined, target.data)}}}};
+    if (!j.vae || j.ref_rgb.empty()) return m;
+    const int w = in.width, h = in.height, iw = 8 * w, ih = 8 * h;
+    std::vector<float> dec_rendered = j.vae->decode(in.latent, w, h), dec_refined = j.vae->decode(refined, w, h);
+    m["rendered"].update(rgb_metrics(dec_rendered, j.ref_rgb, iw, ih, j.lpips.get()));
+    m["refined"].update(rgb_metrics(dec_refined, j.ref_rgb, iw, ih, j.lpips.get()));
+    if (j.path_traced)
+        m["vae_roundtrip"] = rgb_metrics(j.vae->decode(j.vae->encode(j.ref_rgb, iw, ih), w, h), j.ref_rgb, iw, ih, j.lpips.get());
+    m["reference"] = j.path_traced ? "reference_rgb.exr (path-traced RGB)" : "decoded target.exr";
+    write_png_display((dir / "decoded_refined.png").string(), Image{iw, ih, 3, dec_refined, {}});
+    return m;
+}
+
+std::string refine_status(const RefinerRecord& r) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "loss %.4f (smoothed %.4f; mse %.4f dssim %.4f lpips %.4f)", r.loss, r.smoothed, r.mse, r.dssim, r.lpips);
+    return buf;
+}
+
+}  // namespace
+
+RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
+    const fs::path dir(job.fitdir);
+    RefinerInput in = load_refiner_input((dir / "latent.exr").string(), (dir / "aov.exr").string());
+    const Image target = read_fit_image((dir / "target.exr").string(), kLatentChannels, in.width, in.height);
+    const Judges judges = open_judges(job, target, report);
+
+    RefinerConfig cfg = job.net;
+    cfg.latent_channels = kLatentChannels;
+    cfg.distance_scale = mean_hit_distance(in);
+    auto refiner = Refiner::create(cfg, job.train.seed);
+    RefinerTrainOptions o = job.train;
+    o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();
+    o.resume = job.resume && fs::exists(o.checkpoint_path);
+    bool cancelled = false;
+    auto on_iteration = [&](const RefinerRecord& r) {
+        StageProgress p;
+        p.stage = "refine";
+        p.step = r.iteration + 1;
+        p.total = o.iterations;
+        p.seconds = r.seconds;
+        p.status = refine_status(r);
+        cancelled = !report.step(p);
+        return !cancelled;
+    };
+    RefineSummary s;
+    s.result = refiner->train(in, target.data, judges.ref_rgb.empty() ? nullptr : &judges.ref_rgb, judges.vae.get(), judges.lpips.get(), o,
+                              on_iteration);
+    if (cancelled) throw Cancelled("refine");
+    char best[96];
+    std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss, s.result.best_iteration);
+    report.say(best);
+    refiner->save((dir / "refiner.pt").string());
+
+    const std::vector<float> refined = refiner->refine(in);
+    write_latent((dir / "latent_refined.exr").string(), in.width, in.height, refined);
+    write_text_atomic((dir / "refiner_loss.csv").string(), refiner_csv(s.result));
+    s.metrics = judge(dir, in, refined, target, judges);
+    s.metrics["refiner"] = training_record(job, *refiner, s.result);
+    s.decoded = judges.vae != nullptr && !judges.ref_rgb.empty();
+    write_text_atomic((dir / "metrics.json").string(), s.metrics.dump(2));
+    return s;
+}
+
+}  // namespace lpt::pipeline

@@ -1,0 +1,29 @@
+// Stage 2 as a library call: trains the per-scene refiner on a fit folder's final render
+// (latent.exr, aov.exr) against target.exr (and reference_rgb.exr for LPIPS when present) and
+// writes refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json and decoded_refined.png.
+#pragma once
+#include "pipeline/progress.h"
+#include "refiner/refiner.h"
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace lpt::pipeline {
+
+struct RefineJob {
+    std::string fitdir;
+    RefinerConfig net;          ///< expansion, squash, dropout (distance_scale comes from the view)
+    RefinerTrainOptions train;  ///< iterations, lr, loss weights, crops, patience, seed, checkpoint_every
+    bool resume = false;        ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
+    std::string lpips_dir;      ///< empty = ../shared/models/lpips
+};
+
+struct RefineSummary {
+    RefinerTrainResult result;
+    nlohmann::json metrics;     ///< what metrics.json holds: rendered / refined / vae_roundtrip
+    bool decoded = false;       ///< a VAE was found: decoded_refined.png written, RGB metrics present
+};
+
+/// Throws Cancelled when the reporter cancels (refiner_checkpoint.pt keeps the last checkpoint).
+RefineSummary run_refine(const RefineJob& job, const Reporter& report = {});
+
+}  // namespace lpt::pipeline

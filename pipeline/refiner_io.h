@@ -1,0 +1,22 @@
+// What the refiner reads beside a rendered latent: AOVs (normal, distance) of the same view, and
+// their file in a fit folder (aov.exr, channels N.X N.Y N.Z Z).
+#pragma once
+#include "refiner/refiner.h"
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lpt {
+class Scene;
+}
+
+namespace lpt::pipeline {
+
+/// AOVs of `scene` at the latent's resolution, averaged over `spp` camera samples with `seed`
+/// (as the latent was rendered), around `latent`.
+RefinerInput refiner_view(const Scene& scene, std::vector<float> latent, int w, int h, int spp, uint64_t seed);
+void write_refiner_aovs(const std::string& path, const RefinerInput& in);
+/// Throws naming the file when either is missing or has the wrong size or channels.
+RefinerInput load_refiner_input(const std::string& latent_exr, const std::string& aov_exr);
+
+}  // namespace lpt::pipeline
