@@ -35,6 +35,13 @@ struct LightSample {
     bool valid() const { return pdf > 0.f; }
 };
 
+/// An area emitter on shape `shape` from its description (type "area": radiance), as BSDFs are
+/// built by make_bsdf; errors name props.file and props.where + the key.
+Emitter make_area_emitter(const Props& props, int shape);
+/// The environment from its description: type "constant" (radiance) or "envmap" (filename,
+/// absolute; scale; to_world). The map is loaded now, so a missing file fails at load time.
+Emitter make_environment_emitter(const Props& props);
+
 /// Area light: uniform point on the shape, converted to solid angle at `ref`. Zero pdf when the
 /// sample faces away (one-sided emission).
 LightSample sample_area_light(const Shape& shape, const Vec3f& ref, const Eigen::Vector3f& u);

@@ -3,6 +3,7 @@
 #include "core/bsdf.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "core/shape_factory.h"
 #include "core/envmap.h"
 #include "core/texture.h"
 #include <nlohmann/json.hpp>
@@ -115,12 +116,6 @@ struct Ctx {
     }
 };
 
-/// Turns a surface inside out: reversed winding and negated normals (Mitsuba `flip_normals`).
-void flip_normals(TriangleMesh& m) {
-    for (size_t t = 0; t < m.triangle_count(); ++t) std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
-    for (auto& n : m.normals) n = -n;
-}
-
 void apply_define(json& root, const std::string& key, const std::string& value, const std::string& file) {
     // "integrator.spp=64": walk the object path, parse the value as JSON (fallback: string).
     json* node = &root;
@@ -136,6 +131,212 @@ void apply_define(json& root, const std::string& key, const std::string& value, 
         if (!node->is_object()) throw SceneError(file, key, "cannot override: not an object path");
         node = &(*node)[part];
         start = dot + 1;
+    }
+}
+
+bool known_shape_type(const std::string& t) {
+    return t == "obj" || t == "ply" || t == "gltf" || t == "mesh" || t == "rectangle" || t == "cube" || t == "sphere";
+}
+
+bool is_mesh_file(const std::string& t) { return t == "obj" || t == "ply" || t == "gltf"; }
+
+/// A shape object's placement and file keys as the Props make_shape reads (the rest of the object,
+/// material and emitter, is read by the caller); the filename relative to the scene's folder.
+Props shape_props(const Ctx& c, const json& s, const std::string& f, const std::string& type) {
+    Props p;
+    p.type = type;
+    p.file = c.file;
+    p.where = f;
+    for (const char* key : {"face_normals", "flip_normals"})
+        if (auto* v = c.opt(s, key)) {
+            if (!v->is_boolean()) c.fail(f + "." + key, "expected a boolean");
+            p.values[key] = v->get<bool>();
+        }
+    if (auto* v = c.opt(s, "flip_tex_coords"); v && v->is_boolean()) p.values["flip_tex_coords"] = v->get<bool>();
+    if (is_mesh_file(type)) {
+        if (!s.contains("filename")) c.fail(f + ".filename", "missing");
+        p.values["filename"] = (c.dir / c.string(s["filename"], f + ".filename")).string();
+    }
+    if (type == "sphere") {
+        if (auto* v = c.opt(s, "radius")) p.values["radius"] = c.number(*v, f + ".radius");
+        if (auto* v = c.opt(s, "center")) p.values["center"] = Eigen::Array3f(c.vec3(*v, f + ".center").array());
+    }
+    if (auto* t = c.opt(s, "to_world")) p.values["to_world"] = c.transform(*t, f + ".to_world");
+    return p;
+}
+
+/// latentpt JSON's inline "mesh": positions and polygons (fan-triangulated), in object space.
+TriangleMesh inline_mesh(const Ctx& c, const json& s, const std::string& f) {
+    TriangleMesh mesh;
+    const json* pj = c.opt(s, "positions");
+    const json* xj = c.opt(s, "indices");
+    if (!pj || !pj->is_array()) c.fail(f + ".positions", "expected an array of [x,y,z]");
+    if (!xj || !xj->is_array()) c.fail(f + ".indices", "expected an array of [i,j,k] (or polygons, fan-triangulated)");
+    for (size_t k = 0; k < pj->size(); ++k) mesh.positions.push_back(c.vec3((*pj)[k], f + ".positions[" + std::to_string(k) + "]"));
+    for (size_t k = 0; k < xj->size(); ++k) {
+        std::string ff = f + ".indices[" + std::to_string(k) + "]";
+        const json& poly = (*xj)[k];
+        if (!poly.is_array() || poly.size() < 3) c.fail(ff, "expected a polygon of >= 3 vertex indices");
+        std::vector<uint32_t> vs;
+        for (const auto& x : poly) {
+            int id = c.integer(x, ff);
+            if (id < 0 || id >= int(mesh.positions.size()))
+                c.fail(ff, "vertex index " + std::to_string(id) + " out of range [0, " + std::to_string(mesh.positions.size()) + ")");
+            vs.push_back(uint32_t(id));
+        }
+        for (size_t t = 1; t + 1 < vs.size(); ++t) mesh.indices.insert(mesh.indices.end(), {vs[0], vs[t], vs[t + 1]});
+    }
+    return mesh;
+}
+
+}  // namespace
+
+namespace {
+
+void read_integrator(const Ctx& c, const json& root, IntegratorSettings& s) {
+    const json* ij = c.opt(root, "integrator");
+    if (!ij) return;
+    if (auto* v = c.opt(*ij, "max_depth")) s.max_depth = c.integer(*v, "integrator.max_depth");
+    if (auto* v = c.opt(*ij, "rr_depth")) s.rr_depth = c.integer(*v, "integrator.rr_depth");
+    if (auto* v = c.opt(*ij, "spp")) s.spp = c.integer(*v, "integrator.spp");
+    if (s.spp < 1) c.fail("integrator.spp", "must be >= 1");
+    if (auto* v = c.opt(*ij, "sampler")) {
+        std::string m = c.string(*v, "integrator.sampler");
+        if (!parse_sampler(m, s.sampler)) c.fail("integrator.sampler", "expected sobol or independent, got '" + m + "'");
+    }
+    if (auto* v = c.opt(*ij, "light_sampling")) {
+        std::string m = c.string(*v, "integrator.light_sampling");
+        if (m == "power") s.light_sampling = LightSampling::Power;
+        else if (m == "area") s.light_sampling = LightSampling::Area;
+        else if (m == "uniform") s.light_sampling = LightSampling::Uniform;
+        else c.fail("integrator.light_sampling", "expected power, area or uniform, got '" + m + "'");
+    }
+}
+
+void read_camera(const Ctx& c, const json& root, Camera& cam) {
+    const json* cj = c.opt(root, "camera");
+    if (!cj) c.fail("camera", "missing");
+    if (auto* t = c.opt(*cj, "type"); t && c.string(*t, "camera.type") != "perspective")
+        c.fail("camera.type", "unknown camera type '" + t->get<std::string>() + "' (known: perspective)");
+    if (auto* v = c.opt(*cj, "fov")) cam.fov = c.number(*v, "camera.fov");
+    if (!(cam.fov > 0.f && cam.fov < 180.f)) c.fail("camera.fov", "must be in (0, 180) degrees");
+    if (auto* v = c.opt(*cj, "fov_axis")) {
+        std::string a = c.string(*v, "camera.fov_axis");
+        if (a == "x") cam.fov_axis = FovAxis::X;
+        else if (a == "y") cam.fov_axis = FovAxis::Y;
+        else if (a == "smaller") cam.fov_axis = FovAxis::Smaller;
+        else if (a == "larger") cam.fov_axis = FovAxis::Larger;
+        else c.fail("camera.fov_axis", "expected x, y, smaller or larger");
+    }
+    if (auto* v = c.opt(*cj, "to_world")) cam.world_from_camera = c.transform(*v, "camera.to_world");
+    if (auto* v = c.opt(*cj, "width")) cam.width = c.integer(*v, "camera.width");
+    if (auto* v = c.opt(*cj, "height")) cam.height = c.integer(*v, "camera.height");
+    if (cam.width < 1 || cam.height < 1) c.fail("camera.width", "resolution must be positive");
+    if (auto* v = c.opt(*cj, "near_clip")) cam.near_clip = c.number(*v, "camera.near_clip");
+    if (auto* v = c.opt(*cj, "far_clip")) cam.far_clip = c.number(*v, "camera.far_clip");
+    if (auto* f = c.opt(*cj, "filter")) {
+        std::string ft = f->is_object() && f->contains("type") ? c.string((*f)["type"], "camera.filter.type") : "";
+        if (ft == "box") cam.filter = {PixelFilter::Type::Box, 0.5f};
+        else if (ft == "tent") cam.filter = {PixelFilter::Type::Tent, 1.f};
+        else c.fail("camera.filter.type", "expected box or tent");
+        if (auto* r = c.opt(*f, "radius")) cam.filter.radius = c.number(*r, "camera.filter.radius");
+        if (!(cam.filter.radius > 0.f)) c.fail("camera.filter.radius", "must be > 0");
+    }
+}
+
+std::map<std::string, int> read_materials(const Ctx& c, const json& root, Scene& scene) {
+    std::map<std::string, int> material_ids;
+    if (const json* mj = c.opt(root, "materials")) {
+        if (!mj->is_object()) c.fail("materials", "expected an object of named materials");
+        for (const auto& [name, m] : mj->items()) {
+            material_ids[name] = int(scene.materials.size());
+            scene.materials.push_back(c.props(m, "materials." + name));
+        }
+    }
+
+    return material_ids;
+}
+
+void read_shapes(const Ctx& c, const json& root, const std::map<std::string, int>& material_ids, Scene& scene) {
+    const json* sj = c.opt(root, "shapes");
+    if (!sj || !sj->is_array()) c.fail("shapes", "missing or not an array");
+    for (size_t i = 0; i < sj->size(); ++i) {
+        const json& s = (*sj)[i];
+        std::string f = "shapes[" + std::to_string(i) + "]";
+        if (!s.is_object()) c.fail(f, "expected an object");
+        const std::string id = s.contains("id") ? c.string(s["id"], f + ".id") : "shape" + std::to_string(i);
+        if (scene.find_shape(id) >= 0) c.fail(f + ".id", "duplicate shape id '" + id + "'");
+        if (!s.contains("type")) c.fail(f + ".type", "missing");
+        const std::string type = c.string(s["type"], f + ".type");
+        if (!known_shape_type(type))
+            c.fail(f + ".type", "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
+        const Props props = shape_props(c, s, f, type);
+        Shape shape = type == "mesh" ? make_shape_from_mesh(inline_mesh(c, s, f), props, kJsonShapeDefaults)
+                                     : make_shape(props, kJsonShapeDefaults);
+        shape.id = id;
+
+        const json* mat = c.opt(s, "material");
+        if (!mat) c.fail(f + ".material", "missing");
+        if (mat->is_string()) {
+            auto it = material_ids.find(mat->get<std::string>());
+            if (it == material_ids.end()) c.fail(f + ".material", "unknown material '" + mat->get<std::string>() + "'");
+            shape.material = it->second;
+        } else {
+            shape.material = int(scene.materials.size());
+            scene.materials.push_back(c.props(*mat, f + ".material"));
+        }
+        if (const json* ej = c.opt(s, "emitter")) {
+            Props ep = c.props(*ej, f + ".emitter");
+            if (ep.type != "area") c.fail(f + ".emitter.type", "shapes take emitters of type 'area', got '" + ep.type + "'");
+            shape.emitter = int(scene.emitters.size());
+            scene.emitters.push_back(make_area_emitter(ep, int(scene.shapes.size())));
+        }
+        scene.shapes.push_back(std::move(shape));
+    }
+}
+
+void read_environment(const Ctx& c, const json& root, Scene& scene) {
+    if (const json* ej = c.opt(root, "emitters")) {
+        if (!ej->is_array()) c.fail("emitters", "expected an array");
+        for (size_t i = 0; i < ej->size(); ++i) {
+            std::string f = "emitters[" + std::to_string(i) + "]";
+            const json& ejson = (*ej)[i];
+            json plain = ejson;  // to_world is a transform, not a plugin value
+            if (plain.is_object()) plain.erase("to_world");
+            Props ep = c.props(plain, f);
+            if (ep.type != "constant" && ep.type != "envmap")
+                c.fail(f + ".type", "top-level emitters must be 'constant' or 'envmap' (area lights belong inside a shape), got '" + ep.type + "'");
+            if (scene.environment >= 0) c.fail(f, "only one environment emitter is supported");
+            if (ep.type == "envmap") {
+                // {"type": "envmap", "filename": "sky.exr", "scale": 1, "to_world": ...}
+                for (const auto& [k, v] : ejson.items())
+                    if (k != "type" && k != "filename" && k != "scale" && k != "to_world") c.fail(f + "." + k, "unknown envmap key (filename, scale, to_world)");
+                const std::string name = ep.get_string("filename", "");
+                if (name.empty()) c.fail(f + ".filename", "missing");
+                ep.values["filename"] = fs::absolute(c.dir / name).lexically_normal().string();
+                if (auto* t = c.opt(ejson, "to_world")) ep.values["to_world"] = c.transform(*t, f + ".to_world");
+            }
+            const Emitter e = make_environment_emitter(ep);
+            scene.environment = int(scene.emitters.size());
+            scene.emitters.push_back(e);
+        }
+    }
+}
+
+/// Validates every material once, now, so errors point at the file before rendering starts. A
+/// bitmap under a key its BSDF reads as a plain colour gets a message saying so.
+void validate_materials(const Scene& scene) {
+    for (size_t mi = 0; mi < scene.materials.size(); ++mi) {
+        const Props& m = scene.materials[mi];
+        try {
+            make_bsdf<3>(m);
+        } catch (const SceneError& e) {
+            // Name the shapes too: a material (and its texture) may serve several.
+            std::string users;
+            for (const Shape& s : scene.shapes)
+                if (s.material == int(mi)) users += (users.empty() ? "" : ", ") + std::string("'") + s.id + "'";
+            throw explain_texture_error(m, e).with_note(users.empty() ? std::string() : " (material of shape " + users + ")");
+        }
     }
 }
 
@@ -157,203 +358,12 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
     Scene scene;
     scene.file = path;
 
-    if (const json* ij = c.opt(root, "integrator")) {
-        auto& s = scene.integrator;
-        if (auto* v = c.opt(*ij, "max_depth")) s.max_depth = c.integer(*v, "integrator.max_depth");
-        if (auto* v = c.opt(*ij, "rr_depth")) s.rr_depth = c.integer(*v, "integrator.rr_depth");
-        if (auto* v = c.opt(*ij, "spp")) s.spp = c.integer(*v, "integrator.spp");
-        if (s.spp < 1) c.fail("integrator.spp", "must be >= 1");
-        if (auto* v = c.opt(*ij, "sampler")) {
-            std::string m = c.string(*v, "integrator.sampler");
-            if (!parse_sampler(m, s.sampler)) c.fail("integrator.sampler", "expected sobol or independent, got '" + m + "'");
-        }
-        if (auto* v = c.opt(*ij, "light_sampling")) {
-            std::string m = c.string(*v, "integrator.light_sampling");
-            if (m == "power") s.light_sampling = LightSampling::Power;
-            else if (m == "area") s.light_sampling = LightSampling::Area;
-            else if (m == "uniform") s.light_sampling = LightSampling::Uniform;
-            else c.fail("integrator.light_sampling", "expected power, area or uniform, got '" + m + "'");
-        }
-    }
-
-    const json* cj = c.opt(root, "camera");
-    if (!cj) c.fail("camera", "missing");
-    {
-        Camera& cam = scene.camera;
-        if (auto* t = c.opt(*cj, "type"); t && c.string(*t, "camera.type") != "perspective")
-            c.fail("camera.type", "unknown camera type '" + t->get<std::string>() + "' (known: perspective)");
-        if (auto* v = c.opt(*cj, "fov")) cam.fov = c.number(*v, "camera.fov");
-        if (!(cam.fov > 0.f && cam.fov < 180.f)) c.fail("camera.fov", "must be in (0, 180) degrees");
-        if (auto* v = c.opt(*cj, "fov_axis")) {
-            std::string a = c.string(*v, "camera.fov_axis");
-            if (a == "x") cam.fov_axis = FovAxis::X;
-            else if (a == "y") cam.fov_axis = FovAxis::Y;
-            else if (a == "smaller") cam.fov_axis = FovAxis::Smaller;
-            else if (a == "larger") cam.fov_axis = FovAxis::Larger;
-            else c.fail("camera.fov_axis", "expected x, y, smaller or larger");
-        }
-        if (auto* v = c.opt(*cj, "to_world")) cam.world_from_camera = c.transform(*v, "camera.to_world");
-        if (auto* v = c.opt(*cj, "width")) cam.width = c.integer(*v, "camera.width");
-        if (auto* v = c.opt(*cj, "height")) cam.height = c.integer(*v, "camera.height");
-        if (cam.width < 1 || cam.height < 1) c.fail("camera.width", "resolution must be positive");
-        if (auto* v = c.opt(*cj, "near_clip")) cam.near_clip = c.number(*v, "camera.near_clip");
-        if (auto* v = c.opt(*cj, "far_clip")) cam.far_clip = c.number(*v, "camera.far_clip");
-        if (auto* f = c.opt(*cj, "filter")) {
-            std::string ft = f->is_object() && f->contains("type") ? c.string((*f)["type"], "camera.filter.type") : "";
-            if (ft == "box") cam.filter = {PixelFilter::Type::Box, 0.5f};
-            else if (ft == "tent") cam.filter = {PixelFilter::Type::Tent, 1.f};
-            else c.fail("camera.filter.type", "expected box or tent");
-            if (auto* r = c.opt(*f, "radius")) cam.filter.radius = c.number(*r, "camera.filter.radius");
-            if (!(cam.filter.radius > 0.f)) c.fail("camera.filter.radius", "must be > 0");
-        }
-    }
-
-    std::map<std::string, int> material_ids;
-    if (const json* mj = c.opt(root, "materials")) {
-        if (!mj->is_object()) c.fail("materials", "expected an object of named materials");
-        for (const auto& [name, m] : mj->items()) {
-            material_ids[name] = int(scene.materials.size());
-            scene.materials.push_back(c.props(m, "materials." + name));
-        }
-    }
-
-    const json* sj = c.opt(root, "shapes");
-    if (!sj || !sj->is_array()) c.fail("shapes", "missing or not an array");
-    for (size_t i = 0; i < sj->size(); ++i) {
-        const json& s = (*sj)[i];
-        std::string f = "shapes[" + std::to_string(i) + "]";
-        if (!s.is_object()) c.fail(f, "expected an object");
-        Shape shape;
-        shape.id = s.contains("id") ? c.string(s["id"], f + ".id") : "shape" + std::to_string(i);
-        if (scene.find_shape(shape.id) >= 0) c.fail(f + ".id", "duplicate shape id '" + shape.id + "'");
-        if (!s.contains("type")) c.fail(f + ".type", "missing");
-        std::string type = c.string(s["type"], f + ".type");
-        if (auto* v = c.opt(s, "face_normals")) {
-            if (!v->is_boolean()) c.fail(f + ".face_normals", "expected a boolean");
-            shape.face_normals = v->get<bool>();
-        }
-        if (type == "obj" || type == "ply" || type == "gltf") {
-            if (!s.contains("filename")) c.fail(f + ".filename", "missing");
-            fs::path mp = c.dir / c.string(s["filename"], f + ".filename");
-            bool flip = s.contains("flip_tex_coords") && s["flip_tex_coords"].is_boolean() && s["flip_tex_coords"].get<bool>();
-            try {
-                shape.mesh = load_mesh_file(mp.string(), flip);
-            } catch (const SceneError& e) {
-                c.fail(f + ".filename", e.what());
-            }
-        } else if (type == "mesh") {
-            const json* pj = c.opt(s, "positions");
-            const json* xj = c.opt(s, "indices");
-            if (!pj || !pj->is_array()) c.fail(f + ".positions", "expected an array of [x,y,z]");
-            if (!xj || !xj->is_array()) c.fail(f + ".indices", "expected an array of [i,j,k] (or polygons, fan-triangulated)");
-            for (size_t k = 0; k < pj->size(); ++k) shape.mesh.positions.push_back(c.vec3((*pj)[k], f + ".positions[" + std::to_string(k) + "]"));
-            for (size_t k = 0; k < xj->size(); ++k) {
-                std::string ff = f + ".indices[" + std::to_string(k) + "]";
-                const json& poly = (*xj)[k];
-                if (!poly.is_array() || poly.size() < 3) c.fail(ff, "expected a polygon of >= 3 vertex indices");
-                std::vector<uint32_t> vs;
-                for (const auto& x : poly) {
-                    int id = c.integer(x, ff);
-                    if (id < 0 || id >= int(shape.mesh.positions.size()))
-                        c.fail(ff, "vertex index " + std::to_string(id) + " out of range [0, " + std::to_string(shape.mesh.positions.size()) + ")");
-                    vs.push_back(uint32_t(id));
-                }
-                for (size_t t = 1; t + 1 < vs.size(); ++t) shape.mesh.indices.insert(shape.mesh.indices.end(), {vs[0], vs[t], vs[t + 1]});
-            }
-        } else if (type == "rectangle") {
-            shape.mesh = make_rectangle();
-        } else if (type == "cube") {
-            shape.mesh = make_cube();
-        } else if (type == "sphere") {
-            shape.mesh = make_sphere();
-            float r = s.contains("radius") ? c.number(s["radius"], f + ".radius") : 1.f;
-            if (!(r > 0.f)) c.fail(f + ".radius", "must be > 0");
-            Vec3f center = s.contains("center") ? c.vec3(s["center"], f + ".center") : Vec3f::Zero();
-            shape.mesh.transform(Transform::translate(center) * Transform::scale(Vec3f::Constant(r)));
-        } else {
-            c.fail(f + ".type", "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
-        }
-        if (auto* t = c.opt(s, "to_world")) shape.mesh.transform(c.transform(*t, f + ".to_world"));
-        if (auto* v = c.opt(s, "flip_normals")) {
-            if (!v->is_boolean()) c.fail(f + ".flip_normals", "expected a boolean");
-            if (v->get<bool>()) flip_normals(shape.mesh);
-        }
-        validate_mesh(shape.mesh, path, f, false);
-
-        const json* mat = c.opt(s, "material");
-        if (!mat) c.fail(f + ".material", "missing");
-        if (mat->is_string()) {
-            auto it = material_ids.find(mat->get<std::string>());
-            if (it == material_ids.end()) c.fail(f + ".material", "unknown material '" + mat->get<std::string>() + "'");
-            shape.material = it->second;
-        } else {
-            shape.material = int(scene.materials.size());
-            scene.materials.push_back(c.props(*mat, f + ".material"));
-        }
-        if (const json* ej = c.opt(s, "emitter")) {
-            Props ep = c.props(*ej, f + ".emitter");
-            if (ep.type != "area") c.fail(f + ".emitter.type", "shapes take emitters of type 'area', got '" + ep.type + "'");
-            Emitter e;
-            e.kind = EmitterKind::Area;
-            e.shape = int(scene.shapes.size());
-            e.radiance_rgb = ep.get_rgb("radiance");
-            e.props = ep;
-            shape.emitter = int(scene.emitters.size());
-            scene.emitters.push_back(e);
-        }
-        scene.shapes.push_back(std::move(shape));
-    }
-
-    if (const json* ej = c.opt(root, "emitters")) {
-        if (!ej->is_array()) c.fail("emitters", "expected an array");
-        for (size_t i = 0; i < ej->size(); ++i) {
-            std::string f = "emitters[" + std::to_string(i) + "]";
-            const json& ejson = (*ej)[i];
-            json plain = ejson;  // to_world is a transform, not a plugin value
-            if (plain.is_object()) plain.erase("to_world");
-            Props ep = c.props(plain, f);
-            if (ep.type != "constant" && ep.type != "envmap")
-                c.fail(f + ".type", "top-level emitters must be 'constant' or 'envmap' (area lights belong inside a shape), got '" + ep.type + "'");
-            if (scene.environment >= 0) c.fail(f, "only one environment emitter is supported");
-            Emitter e;
-            e.props = ep;
-            if (ep.type == "constant") {
-                e.kind = EmitterKind::Constant;
-                e.radiance_rgb = ep.get_rgb("radiance");
-            } else {
-                // {"type": "envmap", "filename": "sky.exr", "scale": 1, "to_world": ...}
-                for (const auto& [k, v] : ejson.items())
-                    if (k != "type" && k != "filename" && k != "scale" && k != "to_world") c.fail(f + "." + k, "unknown envmap key (filename, scale, to_world)");
-                const std::string name = ep.get_string("filename", "");
-                if (name.empty()) c.fail(f + ".filename", "missing");
-                Transform to_world;
-                if (auto* t = c.opt(ejson, "to_world")) to_world = c.transform(*t, f + ".to_world");
-                try {
-                    e.envmap = EnvMap::load(fs::absolute(c.dir / name).lexically_normal().string(), to_world, ep.get_float("scale", 1.f));
-                } catch (const SceneError& err) {
-                    c.fail(f + ".filename", err.what());
-                }
-                e.kind = EmitterKind::EnvMap;
-                e.radiance_rgb = e.envmap->mean_radiance();
-            }
-            scene.environment = int(scene.emitters.size());
-            scene.emitters.push_back(e);
-        }
-    }
-    // Validate every material once, now, so errors point at the file before rendering starts.
-    // A bitmap under a key its BSDF reads as a plain colour gets a message saying so.
-    for (size_t mi = 0; mi < scene.materials.size(); ++mi) {
-        const Props& m = scene.materials[mi];
-        try {
-            make_bsdf<3>(m);
-        } catch (const SceneError& e) {
-            // Name the shapes too: a material (and its texture) may serve several.
-            std::string users;
-            for (const Shape& s : scene.shapes)
-                if (s.material == int(mi)) users += (users.empty() ? "" : ", ") + std::string("'") + s.id + "'";
-            throw explain_texture_error(m, e).with_note(users.empty() ? std::string() : " (material of shape " + users + ")");
-        }
-    }
+    read_integrator(c, root, scene.integrator);
+    read_camera(c, root, scene.camera);
+    const std::map<std::string, int> material_ids = read_materials(c, root, scene);
+    read_shapes(c, root, material_ids, scene);
+    read_environment(c, root, scene);
+    validate_materials(scene);
     scene.build();
     return scene;
 }

@@ -4,7 +4,9 @@
 // Property parsing, `$name` substitution and transforms are in mitsuba_xml_props.cpp.
 #include "core/bsdf.h"
 #include "core/loaders/mitsuba_xml_detail.h"
+#include "core/loaders/mitsuba_xml_plugin.h"
 #include "core/scene_loader.h"
+#include "core/shape_factory.h"
 #include "core/envmap.h"
 #include "core/texture.h"
 #include <filesystem>
@@ -19,19 +21,6 @@ using namespace mitsuba_xml;
 
 namespace {
 
-/// A plugin element (<bsdf>, <shape>, ...) with its properties parsed and its nested objects and
-/// <ref>s kept in document order.
-struct Plugin {
-    std::string tag, type, id, where;  ///< where: "shape 'floor'", for error fields
-    int line = -1;
-    std::map<std::string, Value> values;
-    std::vector<pugi::xml_node> children;
-    const Value* find(const std::string& name) const {
-        auto it = values.find(name);
-        return it == values.end() ? nullptr : &it->second;
-    }
-};
-
 struct IdEntry {
     std::string tag;
     int line = -1;
@@ -39,17 +28,9 @@ struct IdEntry {
     int material = -1;             ///< index in Scene::materials once a shape uses it
 };
 
-/// The error `e` (thrown by a plugin factory for this file) again, with the XML line added.
-[[noreturn]] void rethrow_at(const Source& src, const SceneError& e, int line) {
-    std::string what = e.what();
-    std::string prefix = e.file() + (e.field().empty() ? "" : ": field '" + e.field() + "'") + ": ";
-    bool ours = e.file() == src.path() && what.rfind(prefix, 0) == 0;
-    throw SceneError(src.path(), e.field(), ours ? what.substr(prefix.size()) : what, line);
-}
-
-class Loader {
+class Loader : private PluginReader {
 public:
-    Loader(const Source& src, Scene& scene) : src(src), scene(scene), dir(fs::path(src.path()).parent_path()) {}
+    Loader(const Source& src, Scene& scene) : PluginReader(src), scene(scene), dir(fs::path(src.path()).parent_path()) {}
 
     void load(const pugi::xml_node& root) {
         for (pugi::xml_node c : root.children()) {
@@ -71,36 +52,12 @@ public:
     }
 
 private:
-    const Source& src;
     Scene& scene;
     fs::path dir;
     std::map<std::string, IdEntry> ids;
     bool have_sensor = false, have_integrator = false;
     int default_material = -1;
     std::vector<int> unnamed_shapes;
-
-    Plugin read_plugin(const pugi::xml_node& n, const std::string& what) {
-        check_attributes(src, n, {"type", "id", "name"});
-        Plugin p;
-        p.tag = n.name();
-        p.type = required_attribute(src, n, "type");
-        p.id = n.attribute("id").value();
-        p.line = src.line(n);
-        p.where = p.id.empty() ? what : what + " '" + p.id + "'";
-        for (pugi::xml_node c : n.children()) {
-            if (c.type() != pugi::node_element) continue;
-            if (!is_property_tag(c.name())) {
-                p.children.push_back(c);
-                continue;
-            }
-            Value v;
-            std::string name = parse_property(src, c, v);
-            if (const Value* old = p.find(name))
-                src.fail(c, p.where + "." + name, "property '" + name + "' is given twice (first at line " + std::to_string(old->line) + ")");
-            p.values[name] = v;
-        }
-        return p;
-    }
 
     void register_id(const std::string& id, const std::string& tag, int line, std::shared_ptr<Props> props = nullptr) {
         if (id.empty()) return;
@@ -115,67 +72,6 @@ private:
         return it->second;
     }
 
-    // Typed property access; a property of the wrong kind is an error at its line.
-    const Value* typed(const Plugin& p, const std::string& name, std::initializer_list<ValueKind> kinds, const char* expected) const {
-        const Value* v = p.find(name);
-        if (!v) return nullptr;
-        for (ValueKind k : kinds)
-            if (v->kind == k) return v;
-        src.fail_at(v->line, p.where + "." + name, std::string("expected <") + expected + ">, got <" + kind_name(v->kind) + ">");
-    }
-    float get_float(const Plugin& p, const std::string& name, float def) const {
-        const Value* v = typed(p, name, {ValueKind::Float, ValueKind::Integer}, "float");
-        return v ? std::get<float>(v->value) : def;
-    }
-    long long get_int(const Plugin& p, const std::string& name, long long def) const {
-        const Value* v = typed(p, name, {ValueKind::Integer}, "integer");
-        return v ? v->integer : def;
-    }
-    bool get_bool(const Plugin& p, const std::string& name, bool def) const {
-        const Value* v = typed(p, name, {ValueKind::Boolean}, "boolean");
-        return v ? std::get<bool>(v->value) : def;
-    }
-    std::string get_string(const Plugin& p, const std::string& name, const std::string& def) const {
-        const Value* v = typed(p, name, {ValueKind::String}, "string");
-        return v ? std::get<std::string>(v->value) : def;
-    }
-    Transform get_transform(const Plugin& p, const std::string& name) const {
-        const Value* v = typed(p, name, {ValueKind::Transform}, "transform");
-        return v ? std::get<Transform>(v->value) : Transform();
-    }
-    Vec3f get_point(const Plugin& p, const std::string& name, const Vec3f& def) const {
-        const Value* v = typed(p, name, {ValueKind::Point, ValueKind::Vector}, "point");
-        return v ? Vec3f(std::get<Eigen::Array3f>(v->value).matrix()) : def;
-    }
-    [[noreturn]] void fail_value(const Plugin& p, const std::string& name, const std::string& msg) const {
-        const Value* v = p.find(name);
-        src.fail_at(v ? v->line : p.line, p.where + "." + name, msg);
-    }
-    /// Mitsuba rejects properties a plugin never reads; so do we, so typos and unsupported
-    /// features (e.g. focal_length) surface instead of rendering something else.
-    void allow_only(const Plugin& p, std::initializer_list<const char*> names) const {
-        for (const auto& [k, v] : p.values) {
-            bool ok = false;
-            for (const char* n : names) ok = ok || k == n;
-            if (ok) continue;
-            std::string known;
-            for (const char* n : names) known += (known.empty() ? "" : ", ") + std::string(n);
-            src.fail_at(v.line, p.where + "." + k, "<" + p.tag + " type=\"" + p.type + "\"> does not support property '" + k + "'" +
-                                                       (known.empty() ? "" : " (supported: " + known + ")"));
-        }
-    }
-    [[noreturn]] void unknown_plugin(const Plugin& p, const std::string& known) const {
-        src.fail_at(p.line, p.where + ".type", "unknown " + p.tag + " plugin '" + p.type + "' (known: " + known + ")");
-    }
-    [[noreturn]] void unexpected_child(const Plugin& p, const pugi::xml_node& c) const {
-        src.fail(c, p.where, "unexpected <" + std::string(c.name()) + "> inside <" + p.tag + " type=\"" + p.type + "\">");
-    }
-    /// A <texture> where only BSDFs take one (shapes, emitters).
-    [[noreturn]] void fail_texture(const Plugin& p, const pugi::xml_node& n) const {
-        std::string name = n.attribute("name").value();
-        src.fail(n, p.where + "." + name, "textured '" + name + "' on <" + p.tag + " type=\"" + p.type +
-                                              "\"> is not supported yet (bitmap textures work as BSDF parameters)");
-    }
     void skip_medium(const pugi::xml_node& n) {
         // Media are ignored (none of our scenes needs one); keep the id so refs to it resolve.
         register_id(n.attribute("id").value(), "medium", src.line(n));
@@ -383,7 +279,7 @@ private:
         if (p.type == "area") src.fail_at(p.line, p.where + ".type", "an 'area' emitter must be nested inside a <shape>");
         if (p.type != "constant" && p.type != "envmap") unknown_plugin(p, "area (inside a shape), constant, envmap");
         if (scene.environment >= 0) src.fail_at(p.line, p.where, "only one environment emitter is supported");
-        Emitter e = p.type == "envmap" ? read_envmap(p) : read_emitter_props(p, EmitterKind::Constant);
+        Emitter e = p.type == "envmap" ? read_envmap(p) : read_emitter_props(p, EmitterKind::Constant, -1);
         register_id(p.id, p.tag, p.line);
         scene.environment = int(scene.emitters.size());
         scene.emitters.push_back(e);
@@ -395,83 +291,64 @@ private:
         for (const pugi::xml_node& c : p.children) unexpected_child(p, c);
         const std::string name = get_string(p, "filename", "");
         if (name.empty()) src.fail_at(p.line, p.where + ".filename", "missing");
-        const std::string file = fs::absolute(dir / name).lexically_normal().string();
-        Emitter e;
-        e.kind = EmitterKind::EnvMap;
-        e.props = to_props(p);
+        get_float(p, "scale", 1.f);
+        get_transform(p, "to_world");
+        Props props = to_props(p);
+        props.values["filename"] = fs::absolute(dir / name).lexically_normal().string();
         try {
-            e.envmap = EnvMap::load(file, get_transform(p, "to_world"), get_float(p, "scale", 1.f));
+            return make_environment_emitter(props);
         } catch (const SceneError& err) {
-            fail_value(p, "filename", std::string(err.what()) + " (the environment map; see the scene's SOURCE/README for where to get it)");
+            fail_value(p, "filename", err.message() + " (the environment map; see the scene's SOURCE/README for where to get it)");
         }
-        e.radiance_rgb = e.envmap->mean_radiance();
-        return e;
     }
 
-    Emitter read_emitter_props(const Plugin& p, EmitterKind kind) {
+    Emitter read_emitter_props(const Plugin& p, EmitterKind kind, int shape) {
         allow_only(p, {"radiance"});
         for (const pugi::xml_node& c : p.children) {
             if (std::string(c.name()) == "texture") fail_texture(p, c);
             unexpected_child(p, c);
         }
-        Emitter e;
-        e.kind = kind;
-        e.props = to_props(p);
         try {
-            e.radiance_rgb = e.props.get_rgb("radiance");
+            return kind == EmitterKind::Area ? make_area_emitter(to_props(p), shape) : make_environment_emitter(to_props(p));
         } catch (const SceneError& err) {
             rethrow_at(src, err, p.line);
         }
-        return e;
+    }
+
+    /// A shape's properties checked against what its type takes, each of its XML kind (a wrong
+    /// kind is an error at its line), as the Props make_shape reads; the filename relative to
+    /// the XML's folder, as Mitsuba resolves it.
+    Props shape_props(const Plugin& p) const {
+        const std::string& t = p.type;
+        if (t == "obj") allow_only(p, {"filename", "face_normals", "flip_tex_coords", "flip_normals", "to_world"});
+        else if (t == "ply") allow_only(p, {"filename", "face_normals", "flip_normals", "to_world"});
+        else if (t == "rectangle" || t == "cube") allow_only(p, {"flip_normals", "to_world"});
+        else if (t == "sphere") allow_only(p, {"center", "radius", "flip_normals", "to_world"});
+        else unknown_plugin(p, "obj, ply, rectangle, cube, sphere");
+        if ((t == "obj" || t == "ply") && !p.find("filename")) src.fail_at(p.line, p.where + ".filename", "missing");
+        Props out;
+        out.type = t;
+        out.file = src.path();
+        out.where = p.where;
+        if (p.find("filename")) out.values["filename"] = (dir / get_string(p, "filename", "")).string();
+        for (const char* key : {"face_normals", "flip_tex_coords", "flip_normals"})
+            if (p.find(key)) out.values[key] = get_bool(p, key, false);
+        if (p.find("radius")) out.values["radius"] = get_float(p, "radius", 1.f);
+        if (p.find("center")) out.values["center"] = Eigen::Array3f(get_point(p, "center", Vec3f::Zero()).array());
+        if (p.find("to_world")) out.values["to_world"] = get_transform(p, "to_world");
+        return out;
     }
 
     void read_shape(const pugi::xml_node& n) {
         Plugin p = read_plugin(n, "shape");
+        const Props props = shape_props(p);
         Shape shape;
-        shape.id = p.id;
-        const std::string& t = p.type;
-        if (t == "obj" || t == "ply") {
-            if (t == "obj") allow_only(p, {"filename", "face_normals", "flip_tex_coords", "flip_normals", "to_world"});
-            else allow_only(p, {"filename", "face_normals", "flip_normals", "to_world"});
-            if (!p.find("filename")) src.fail_at(p.line, p.where + ".filename", "missing");
-            fs::path mp = dir / get_string(p, "filename", "");
-            try {
-                // Mitsuba's obj flips v by default (flip_tex_coords = true) and drops zero-area
-                // triangles (the classroom's Mesh042 has two).
-                shape.mesh = t == "obj" ? load_obj(mp.string(), get_bool(p, "flip_tex_coords", true), true) : load_ply(mp.string());
-            } catch (const SceneError& e) {
-                fail_value(p, "filename", e.what());
-            }
-            shape.face_normals = get_bool(p, "face_normals", false);
-        } else if (t == "rectangle" || t == "cube") {
-            allow_only(p, {"flip_normals", "to_world"});
-            shape.mesh = t == "rectangle" ? make_rectangle() : make_cube();
-        } else if (t == "sphere") {
-            allow_only(p, {"center", "radius", "flip_normals", "to_world"});
-            shape.mesh = make_sphere();
-        } else {
-            unknown_plugin(p, "obj, ply, rectangle, cube, sphere");
-        }
-        Transform to_world = get_transform(p, "to_world");
-        if (t == "sphere") {  // as Mitsuba: to_world * translate(center) * scale(radius)
-            float r = get_float(p, "radius", 1.f);
-            if (!(r > 0.f)) fail_value(p, "radius", "must be > 0");
-            to_world = to_world * Transform::translate(get_point(p, "center", Vec3f::Zero())) * Transform::scale(Vec3f::Constant(r));
-        }
-        shape.mesh.transform(to_world);
-        if (get_bool(p, "flip_normals", false)) {
-            auto& m = shape.mesh;
-            for (size_t i = 0; i < m.triangle_count(); ++i) std::swap(m.indices[3 * i + 1], m.indices[3 * i + 2]);
-            for (auto& nn : m.normals) nn = -nn;
-        }
         try {
-            validate_mesh(shape.mesh, src.path(), p.where, true);  // as Mitsuba: drop, don't fail
+            shape = make_shape(props, kMitsubaShapeDefaults);
         } catch (const SceneError& e) {
-            rethrow_at(src, e, p.line);
+            rethrow_at(src, e, line_of(p, e.field()));
         }
-        // A mesh file without normals is smooth-shaded in Mitsuba 3 unless face_normals is set.
-        if ((t == "obj" || t == "ply") && !shape.face_normals && shape.mesh.normals.empty()) compute_vertex_normals(shape.mesh);
-
+        shape.id = p.id;
         const int index = int(scene.shapes.size());
         for (const pugi::xml_node& c : p.children) {
             const std::string tag = c.name();
@@ -494,9 +371,8 @@ private:
                 Plugin ep = read_plugin(c, p.where + ".emitter");
                 if (ep.type != "area") src.fail_at(ep.line, ep.where + ".type", "a shape's emitter must be 'area', got '" + ep.type + "'");
                 if (shape.emitter >= 0) src.fail(c, p.where, "shape has more than one emitter");
-                Emitter e = read_emitter_props(ep, EmitterKind::Area);
+                Emitter e = read_emitter_props(ep, EmitterKind::Area, index);
                 register_id(ep.id, ep.tag, ep.line);
-                e.shape = index;
                 shape.emitter = int(scene.emitters.size());
                 scene.emitters.push_back(e);
             } else if (tag == "medium") {
