@@ -25,25 +25,41 @@ size_t PathRecords::bytes() const {
 
 namespace detail {
 
-struct PathRecorder::Threads {
-    struct Scratch {
-        int tile = 0;
-        std::vector<std::vector<PathEvent>> paths;          ///< per slot, in event order
-        std::vector<std::pair<uint32_t, uint32_t>> pending;  ///< shadow id → (slot, event index)
-        PathBlock block;                                     ///< reused when complete() keeps nothing
-    };
-    tbb::enumerable_thread_specific<Scratch> local;
-    // Every hook of a wavefront runs on the thread that called begin() (path_observer.h).
-    static thread_local Scratch* current;
+struct PathRecorder::Scratch {
+    int tile = 0;
+    std::vector<std::vector<PathEvent>> paths;          ///< per slot, in event order
+    std::vector<std::pair<uint32_t, uint32_t>> pending;  ///< shadow id → (slot, event index)
+    PathBlock block;                                     ///< reused when complete() keeps nothing
 };
-thread_local PathRecorder::Threads::Scratch* PathRecorder::Threads::current = nullptr;
+
+struct PathRecorder::Threads {
+    tbb::enumerable_thread_specific<Scratch> local;
+};
+
+namespace {
+
+/// Every hook of a wavefront runs on the thread that called begin() (path_observer.h), so each
+/// thread remembers the scratch of the wavefront it is recording, per recorder: two recorders
+/// that take turns on one thread (nested renders, two fits) each find their own.
+struct CurrentScratch {
+    const void* recorder = nullptr;
+    void* scratch = nullptr;
+};
+thread_local CurrentScratch t_current;
+
+}  // namespace
+
+PathRecorder::Scratch& PathRecorder::scratch() const {
+    if (t_current.recorder != this) t_current = {this, &m_threads->local.local()};
+    return *static_cast<Scratch*>(t_current.scratch);
+}
 
 PathRecorder::PathRecorder(int n_tiles) : m_threads(std::make_unique<Threads>()), m_records(n_tiles) {}
 PathRecorder::~PathRecorder() = default;
 
 void PathRecorder::begin(int tile, size_t n) {
-    Threads::current = &m_threads->local.local();
-    Threads::Scratch& s = *Threads::current;
+    t_current = {this, &m_threads->local.local()};
+    Scratch& s = scratch();
     s.tile = tile;
     if (s.paths.size() < n) s.paths.resize(n);
     for (size_t i = 0; i < n; ++i) s.paths[i].clear();
@@ -53,15 +69,15 @@ void PathRecorder::emission(uint32_t slot, int emitter, float mis) {
     PathEvent e;
     e.type = PathEvent::Emission;
     e.emitter = emitter;
-    e.scalar = mis;
-    Threads::current->paths[slot].push_back(e);
+    e.mis = mis;
+    scratch().paths[slot].push_back(e);
 }
 
 void PathRecorder::ambient(uint32_t slot, int shape) {
     PathEvent e;
     e.type = PathEvent::Ambient;
     e.shape = shape;
-    Threads::current->paths[slot].push_back(e);
+    scratch().paths[slot].push_back(e);
 }
 
 void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emitter, float w_over_pdf, const BSDFContext& ctx,
@@ -71,11 +87,11 @@ void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emi
     e.shape = shape;
     e.emitter = emitter;
     e.flags = uint8_t((nee ? PathEvent::kNee : 0) | (first ? PathEvent::kFirst : 0));
-    e.scalar = w_over_pdf;
+    e.w_over_pdf = w_over_pdf;
     e.uv = ctx.uv;
     e.wi = wi;
     e.wo = wo;
-    Threads::Scratch& s = *Threads::current;
+    Scratch& s = scratch();
     if (shadow_id >= 0) {
         if (s.pending.size() <= size_t(shadow_id)) s.pending.resize(shadow_id + 1);
         s.pending[shadow_id] = {slot, uint32_t(s.paths[slot].size())};
@@ -84,7 +100,7 @@ void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emi
 }
 
 void PathRecorder::shadow(int shadow_id, bool blocked) {
-    Threads::Scratch& s = *Threads::current;
+    Scratch& s = scratch();
     auto [slot, idx] = s.pending[shadow_id];
     if (!blocked) s.paths[slot][idx].flags |= PathEvent::kVisible;
 }
@@ -94,7 +110,7 @@ void PathRecorder::bounce(uint32_t slot, int shape, const BSDFContext& ctx, cons
     PathEvent e;
     e.type = PathEvent::Bounce;
     e.shape = shape;
-    e.scalar = q;
+    e.survival = q;
     e.lobe = uint8_t(bs.lobe);
     e.depth = uint8_t(depth);
     e.pdf = bs.pdf;
@@ -102,11 +118,11 @@ void PathRecorder::bounce(uint32_t slot, int shape, const BSDFContext& ctx, cons
     e.uv = ctx.uv;
     e.wi = wi;
     e.wo = bs.wo;
-    Threads::current->paths[slot].push_back(e);
+    scratch().paths[slot].push_back(e);
 }
 
 void PathRecorder::end(const uint32_t* pixel, const uint32_t* sample, size_t n) {
-    Threads::Scratch& s = *Threads::current;
+    Scratch& s = scratch();
     PathBlock& b = s.block;
     b.pixel.assign(pixel, pixel + n);
     b.sample.assign(sample, sample + n);
@@ -167,9 +183,9 @@ void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint
         const PathEvent& e = ev[i];
         s.beta[i] = beta;
         if (e.type == PathEvent::Light && (e.flags & PathEvent::kNee) && (e.flags & PathEvent::kVisible)) {
-            s.local[i] = m.spectra().bsdf_of(m.scene(), e.shape).eval(context_of(e), e.wi, e.wo) * e.scalar;
+            s.local[i] = m.spectra().bsdf_of(m.scene(), e.shape).eval(context_of(e), e.wi, e.wo) * e.w_over_pdf;
         } else if (e.type == PathEvent::Bounce) {
-            s.local[i] = bounce_weight(m.spectra().bsdf_of(m.scene(), e.shape), e, sampler, pixel, sample) / e.scalar;
+            s.local[i] = bounce_weight(m.spectra().bsdf_of(m.scene(), e.shape), e, sampler, pixel, sample) / e.survival;
             beta *= s.local[i];
         }
     }
@@ -219,8 +235,8 @@ void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& bl
             const L& beta = s.beta[i];
             switch (e.type) {
                 case PathEvent::Emission:
-                    R += e.scalar * radiance[e.emitter];
-                    add(emitter_slice(m, e.emitter), d * beta * e.scalar);
+                    R += e.mis * radiance[e.emitter];
+                    add(emitter_slice(m, e.emitter), d * beta * e.mis);
                     break;
                 case PathEvent::Ambient:
                     R += e.shape < 0 ? terms.background : terms.La[e.shape];
@@ -238,15 +254,15 @@ void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& bl
                     const BSDF<kLatentChannels>& bsdf = m.spectra().bsdf_of(m.scene(), e.shape);
                     const BSDFContext ctx = context_of(e);
                     const auto& keys = m.slots(e.shape).bsdf;
-                    for (size_t c = 0; c < keys.size(); ++c) add(keys[c].second, d * beta * bsdf.eval_grad(ctx, e.wi, e.wo, int(c)) * (e.scalar * le));
-                    if (!m.slots(e.shape).scalar.empty()) add_scalar(e.shape, d * beta * bsdf.eval_grad_scalar(ctx, e.wi, e.wo, 0) * (e.scalar * le));
+                    for (size_t c = 0; c < keys.size(); ++c) add(keys[c].second, d * beta * bsdf.eval_grad(ctx, e.wi, e.wo, int(c)) * (e.w_over_pdf * le));
+                    if (!m.slots(e.shape).scalar.empty()) add_scalar(e.shape, d * beta * bsdf.eval_grad_scalar(ctx, e.wi, e.wo, 0) * (e.w_over_pdf * le));
                     break;
                 }
                 case PathEvent::Bounce: {
                     const BSDF<kLatentChannels>& bsdf = m.spectra().bsdf_of(m.scene(), e.shape);
                     const BSDFContext ctx = context_of(e);
                     const BSDFSample<kLatentChannels> bs = sample_of(e);
-                    const float inv_q = 1.f / e.scalar;
+                    const float inv_q = 1.f / e.survival;
                     const auto& keys = m.slots(e.shape).bsdf;
                     for (size_t c = 0; c < keys.size(); ++c) add(keys[c].second, d * beta * bsdf.weight_grad(ctx, e.wi, bs, int(c)) * (inv_q * R));
                     if (!m.slots(e.shape).scalar.empty() && !(e.lobe & kDelta))
@@ -293,7 +309,7 @@ std::vector<float> replay_forward(const LatentModel& m, const PathRecords& r) {
                     const PathEvent& e = ev[i];
                     const L& beta = s.beta[i];
                     if (e.type == PathEvent::Emission) {
-                        e_sum += beta * (e.scalar * radiance[e.emitter]);
+                        e_sum += beta * (e.mis * radiance[e.emitter]);
                     } else if (e.type == PathEvent::Ambient) {
                         a_sum += beta * (e.shape < 0 ? terms.background : terms.La[e.shape]);
                     } else if (e.type == PathEvent::Light) {

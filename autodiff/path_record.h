@@ -24,11 +24,18 @@ struct PathEvent {
     uint8_t depth = 0;   ///< Bounce: path depth, to regenerate a delta sample's random numbers
     int32_t shape = -1;  ///< Ambient -1: the background
     int32_t emitter = -1;
-    float scalar = 0.f;  ///< Emission: MIS weight; Light: w_mis / p_light; Bounce: survival q (all × envmap factor where one applies)
+    /// One float per event, named by what it means for the event's type (each reads its own).
+    union {
+        float mis = 0.f;   ///< Emission: MIS weight (× the envmap's relative luminance where one applies)
+        float w_over_pdf;  ///< Light: w_mis / p_light (× the same factor)
+        float survival;    ///< Bounce: Russian-roulette survival probability q (1 before rr_depth)
+    };
     float pdf = 0.f, eta = 1.f;  ///< Bounce: the BSDF sample's pdf and relative IOR
     Vec2f uv = Vec2f::Zero();
     Vec3f wi = Vec3f::Zero(), wo = Vec3f::Zero();  ///< local shading frame
 };
+
+static_assert(sizeof(PathEvent) == 56, "docs/path-replay.md and the memory estimates quote 56 bytes per event");
 
 /// One wavefront: path k is events[begin[k] .. begin[k + 1]), seen by pixel[k] as its sample[k].
 struct PathBlock {
@@ -82,7 +89,9 @@ protected:
     virtual void complete(int tile, PathBlock& block) { m_records[tile].push_back(std::move(block)); }
 
 private:
-    struct Threads;  ///< per-thread wavefront under construction
+    struct Scratch;  ///< one thread's wavefront under construction
+    struct Threads;  ///< every thread's Scratch
+    Scratch& scratch() const;  ///< this thread's, for this recorder
     std::unique_ptr<Threads> m_threads;
     std::vector<std::vector<PathBlock>> m_records;
 };

@@ -81,11 +81,14 @@ public:
     virtual BSDFSample<N> sample(const BSDFContext& ctx, const Vec3f& wi, float u1, const Vec2f& u2) const = 0;
     /// OR of the lobes this BSDF can produce.
     virtual uint32_t flags() const = 0;
-    /// Hemispherical reflectance-like colour for the albedo AOV (not an integral; a display value).
-    /// For a Lambertian BSDF, its reflectance.
+    /// Hemispherical reflectance-like colour for the albedo AOV only (not an integral; a display
+    /// value): no estimator may use it.
     virtual Spectrum<N> albedo(const BSDFContext& ctx) const = 0;
     /// Lambertian::No unless sample() is lambertian_sample() of a cosine-warped direction.
     virtual Lambertian lambertian() const { return Lambertian::No; }
+    /// The reflectance ρ that lambertian_sample weights with, where lambertian() != No (the
+    /// tracer samples those vertices from its batch-warped directions); zero elsewhere.
+    virtual Spectrum<N> lambertian_reflectance(const BSDFContext&) const { return Spectrum<N>::Zero(); }
 
     /// Spectral coefficients exposed to fitting, by scene-file key (e.g. "reflectance"); the
     /// latent renderer fills them from its ParamStore (docs/params.md).

@@ -337,7 +337,8 @@ private:
             const Lambertian lambertian = m_lambertian[sq.shape[k]];
             const BSDFSample<N> bs =
                 lambertian != Lambertian::No
-                    ? lambertian_sample<N>(lambertian, sq.wi[k], Vec3f(ws.cosine[0][k], ws.cosine[1][k], ws.cosine[2][k]), bsdf.albedo(ctx))
+                    ? lambertian_sample<N>(lambertian, sq.wi[k], Vec3f(ws.cosine[0][k], ws.cosine[1][k], ws.cosine[2][k]),
+                                              bsdf.lambertian_reflectance(ctx))
                     : bsdf.sample(ctx, sq.wi[k], ws.u_lobe[k], Vec2f(ws.u_dir[0][k], ws.u_dir[1][k]));
             if (!bs.valid()) continue;
             Spectrum<N> beta = p.beta[slot] * bs.weight;

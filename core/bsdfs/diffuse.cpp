@@ -33,6 +33,7 @@ public:
 
     uint32_t flags() const override { return kDiffuseReflection; }
     Lambertian lambertian() const override { return Lambertian::OneSided; }
+    Spectrum<N> lambertian_reflectance(const BSDFContext& ctx) const override { return m_reflectance.eval(ctx); }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_reflectance.eval(ctx); }
 
     /// ∂ρ/∂c · cos/π: 1 for the constant, g(uv) for .scale, 1 for .offset.

@@ -44,6 +44,7 @@ public:
         return m_nested->lambertian() == Lambertian::OneSided ? Lambertian::TwoSided : Lambertian::No;
     }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_nested->albedo(ctx); }
+    Spectrum<N> lambertian_reflectance(const BSDFContext& ctx) const override { return m_nested->lambertian_reflectance(ctx); }
 
     Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
         return cos_theta(wi) < 0.f ? m_nested->eval_grad(ctx, flip_z(wi), flip_z(wo), key) : m_nested->eval_grad(ctx, wi, wo, key);

@@ -131,3 +131,25 @@ TEST(PathRecord, BackwardIndependentOfThreadsAndRejectsWrongShape) {
     EXPECT_EQ(m.params().grad_values(), g1);
     EXPECT_THROW(replay_backward(m, records, std::vector<float>(7)), std::invalid_argument);
 }
+
+// Two recorders taking turns on one thread (a fit inside a fit, two models) each keep their own
+// wavefront: the per-thread state belongs to the recorder, not to the class.
+TEST(PathRecorder, TwoRecordersOnOneThreadKeepTheirOwnEvents) {
+    detail::PathRecorder a(1), b(1);
+    a.begin(0, 1);
+    b.begin(0, 1);
+    a.emission(0, 3, 0.5f);
+    b.ambient(0, 7);
+    b.ambient(0, 8);
+    const uint32_t pixel = 0, sample = 0;
+    a.end(&pixel, &sample, 1);
+    b.end(&pixel, &sample, 1);
+    ASSERT_EQ(a.records()[0].size(), 1u);
+    ASSERT_EQ(b.records()[0].size(), 1u);
+    const PathBlock &ra = a.records()[0][0], &rb = b.records()[0][0];
+    ASSERT_EQ(ra.events.size(), 1u);
+    EXPECT_EQ(ra.events[0].type, PathEvent::Emission);
+    EXPECT_EQ(ra.events[0].emitter, 3);
+    ASSERT_EQ(rb.events.size(), 2u);
+    EXPECT_EQ(rb.events[1].shape, 8);
+}

@@ -411,6 +411,7 @@ TEST(BSDFSampling, IndependentOfSignedSpectralCoefficients) {
         }
     }
 }
+
 TEST(BSDFLatent, SixteenChannelsCarryLuminance) {
     Props p = props("roughplastic", {{"diffuse_reflectance", rgb(0.2f, 0.5f, 0.8f)}});
     Props q = props("roughplastic", {{"diffuse_reflectance", 0.2126f * 0.2f + 0.7152f * 0.5f + 0.0722f * 0.8f}});
@@ -418,6 +419,33 @@ TEST(BSDFLatent, SixteenChannelsCarryLuminance) {
     Spectrum<16> f = make_bsdf<16>(p)->eval({}, wi, wo);
     float g = make_bsdf<3>(q)->eval({}, wi, wo)[1];
     for (int c = 0; c < 16; ++c) EXPECT_NEAR(f[c], g, 1e-6f);
+}
+
+// The tracer samples Lambertian vertices itself (batch-warped cosine directions) and weights them
+// with lambertian_reflectance(): that must be exactly what the BSDF's own sample() returns, and
+// no other BSDF may claim a Lambertian reflectance.
+TEST(Lambertian, ReflectanceIsWhatSampleWeightsWith) {
+    const Props diffuse = props("diffuse", {{"reflectance", rgb(0.3f, 0.6f, 0.9f)}});
+    for (const Props& p : {diffuse, twosided(diffuse)}) {
+        auto bsdf = make_bsdf<3>(p);
+        ASSERT_NE(bsdf->lambertian(), Lambertian::No) << p.type;
+        const BSDFContext ctx;
+        for (float wz : {0.7f, -0.4f}) {
+            const Vec3f wi = Vec3f(0.3f, -0.2f, wz).normalized();
+            const Vec2f u(0.37f, 0.81f);
+            const BSDFSample<3> own = bsdf->sample(ctx, wi, 0.5f, u);
+            const BSDFSample<3> tracer = lambertian_sample<3>(bsdf->lambertian(), wi, sample_cosine_hemisphere(u), bsdf->lambertian_reflectance(ctx));
+            EXPECT_EQ(own.valid(), tracer.valid()) << p.type;
+            if (!own.valid()) continue;
+            EXPECT_TRUE((own.weight == tracer.weight).all()) << p.type;
+            EXPECT_TRUE(own.wo.isApprox(tracer.wo)) << p.type;
+        }
+    }
+    for (const char* type : {"conductor", "dielectric", "plastic", "roughconductor"}) {
+        auto bsdf = make_bsdf<3>(props(type));
+        EXPECT_EQ(bsdf->lambertian(), Lambertian::No) << type;
+        EXPECT_TRUE((bsdf->lambertian_reflectance(BSDFContext{}) == 0.f).all()) << type;
+    }
 }
 
 }  // namespace
