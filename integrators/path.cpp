@@ -7,12 +7,14 @@
 #include "core/envmap.h"
 #include "core/sampler.h"
 #include "core/warp.h"
+#include "integrators/latent_stage.h"
 #include "integrators/wavefront_state.h"
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 
 namespace lpt {
 
@@ -57,8 +59,9 @@ class PathTracer {
 public:
     PathTracer(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, const Camera& camera,
                const LatentTerms<N>* terms, PathObserver<N>* observer)
-        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_terms(terms), m_obs(observer),
-          m_emission(!terms || terms->emission) {
+        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_obs(observer),
+          m_latent(terms ? std::make_optional<LatentStage<N>>(*terms, observer) : std::nullopt),
+          m_emission(!terms || terms->emission), m_keep_zero(terms != nullptr) {
         m_lambertian.reserve(scene.shapes.size());
         for (size_t s = 0; s < scene.shapes.size(); ++s) m_lambertian.push_back(spectra.bsdf_of(scene, int(s)).lambertian());
     }
@@ -88,7 +91,7 @@ public:
         if (m_obs) m_obs->end(ws.paths.pixel.data(), ws.paths.sample.data(), n);
         for (size_t k = 0; k < n; ++k) {
             films[0]->add_sample(int(ws.paths.pixel[k]), ws.paths.radiance[k]);
-            if (m_terms) {
+            if (m_latent) {
                 films[1]->add_sample(int(ws.paths.pixel[k]), ws.paths.ambient[k]);
                 films[2]->add_sample(int(ws.paths.pixel[k]), ws.paths.occlusion[k]);
             }
@@ -170,10 +173,7 @@ private:
         for (size_t i = 0; i < rays.size; ++i) {
             const uint32_t slot = ws.queue[cur][i];
             if (!rays.hit(i)) {
-                if (m_terms && m_terms->ambient && !p.past_first[slot]) {
-                    p.ambient[slot] += p.beta[slot] * m_terms->background;
-                    if (m_obs) m_obs->ambient(slot, -1);
-                }
+                if (m_latent) m_latent->escaped(p, slot);
                 if (env < 0 || !m_emission) continue;
                 const Vec3f dir = rays.direction(i);
                 const Emitter& em = m_scene.emitters[env];
@@ -182,7 +182,7 @@ private:
                 if (w > 0.f) {
                     float factor;
                     const Spectrum<N> le = emitted(env, dir, &factor);
-                    p.radiance[slot] += p.beta[slot] * (w * le);
+                    p.radiance[slot] += emission_score(p.beta[slot], w, le);
                     if (m_obs) m_obs->emission(slot, env, w * factor);
                 }
                 continue;
@@ -197,24 +197,16 @@ private:
                     float light_pdf = m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
                     float w = hit_weight(p, slot, light_pdf);
                     if (w > 0.f) {
-                        p.radiance[slot] += p.beta[slot] * (w * m_spectra.radiance[shape.emitter]);
+                        p.radiance[slot] += emission_score(p.beta[slot], w, m_spectra.radiance[shape.emitter]);
                         if (m_obs) m_obs->emission(slot, shape.emitter, w);
                     }
                 }
             }
-            // Latent: Ĩa at the first non-delta vertex of E S* D, and flag it for Ĩc's gate.
-            bool first = false;
-            if (m_terms && !p.past_first[slot] && !m_spectra.is_delta(m_scene, shape_id)) {
-                first = true;
-                p.past_first[slot] = 1;
-                if (m_terms->ambient) {
-                    p.ambient[slot] += p.beta[slot] * m_terms->La[shape_id];
-                    if (m_obs) m_obs->ambient(slot, shape_id);
-                }
-            }
+            // Latent: Ĩa at the first non-delta vertex of E S* D; its light sample decides Ĩc.
+            const bool gate_here = m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id));
             // Without Ĩe nothing is collected after the first non-delta vertex.
             const bool cont = may_continue && (m_emission || !p.past_first[slot]);
-            const uint8_t flags = (cont ? ShadeQueue::kContinue : 0) | (first && m_terms->occlusion ? ShadeQueue::kFirst : 0);
+            const uint8_t flags = (cont ? ShadeQueue::kContinue : 0) | (gate_here ? ShadeQueue::kFirst : 0);
             if (!flags) continue;
             const size_t k = sq.count++;
             sq.flags[k] = flags;
@@ -253,10 +245,9 @@ private:
             if (!nee && !first) continue;
             const uint32_t slot = sq.slot[k];
             Spectrum<N> occl = Spectrum<N>::Zero();
-            if (first) occl = p.beta[slot] * m_terms->Lc[sq.shape[k]];
-            const bool gate_shadowed = m_terms && m_terms->gate == OcclusionGate::Shadowed;
+            if (first) occl = m_latent->occlusion(p, slot, sq.shape[k]);
             if (m_scene.lights.empty()) {  // no light: everything is in shadow
-                if (first && gate_shadowed) p.occlusion[slot] += occl;
+                if (first) m_latent->gate(p, slot, occl, false);
                 if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
@@ -267,7 +258,7 @@ private:
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
             const bool reflects_only = !(m_spectra.bsdf_of(m_scene, sq.shape[k]).flags() & kTransmission);
             if (!ls.valid() || (reflects_only && sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f)) {
-                if (first && gate_shadowed) p.occlusion[slot] += occl;
+                if (first) m_latent->gate(p, slot, occl, false);
                 if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
                 continue;
             }
@@ -280,11 +271,11 @@ private:
                 const BSDF<N>& bsdf = m_spectra.bsdf_of(m_scene, sq.shape[k]);
                 const Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
                 // A zero f (a latent reflectance at 0) still has a derivative: keep it for the adjoint.
-                if ((f != 0.f).any() || m_obs) {
+                if ((f != 0.f).any() || m_keep_zero) {
                     float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
                     float factor;
                     const Spectrum<N> le = emitted(ls.emitter, ls.wi, &factor);
-                    contribution = p.beta[slot] * f * le * (w / ls.pdf);
+                    contribution = nee_score(p.beta[slot], f, le, w / ls.pdf);
                     w_over_pdf = w / ls.pdf * factor;  // the observer multiplies by radiance[emitter]
                 } else if (!first) {
                     continue;
@@ -306,7 +297,7 @@ private:
             ws.shadow.rays.push(o, dir, 0.f, tmax);
             ws.shadow.slot.push_back(slot);
             ws.shadow.contribution.push_back(contribution);
-            if (m_terms) ws.shadow.occlusion.push_back(occl);
+            if (m_latent) ws.shadow.occlusion.push_back(occl);
         }
     }
 
@@ -350,7 +341,7 @@ private:
                 beta /= q;
             }
             // A zero throughput contributes nothing but may still have a derivative.
-            if (!(beta != 0.f).any() && !m_obs) continue;
+            if (!(beta != 0.f).any() && !m_keep_zero) continue;
             if (m_obs) m_obs->bounce(slot, sq.shape[k], ctx, sq.wi[k], bs, q, depth);
             const Vec3f wo_world = sq.frame[k].to_world(bs.wo);
             p.beta[slot] = beta;
@@ -370,7 +361,7 @@ private:
             const bool blocked = sq.rays.blocked(j);
             if (m_obs) m_obs->shadow(int(j), blocked);
             if (!blocked) ws.paths.radiance[sq.slot[j]] += sq.contribution[j];
-            if (m_terms && blocked == (m_terms->gate == OcclusionGate::Shadowed)) ws.paths.occlusion[sq.slot[j]] += sq.occlusion[j];
+            if (m_latent) m_latent->gate(ws.paths, sq.slot[j], sq.occlusion[j], !blocked);
         }
     }
 
@@ -378,9 +369,12 @@ private:
     const SceneSpectra<N>& m_spectra;
     const RenderOptions& m_opt;
     const Camera& m_camera;
-    const LatentTerms<N>* m_terms;  ///< null for plain (RGB) rendering
-    PathObserver<N>* m_obs;         ///< null unless an adjoint is replaying
-    const bool m_emission;          ///< Ĩe on
+    PathObserver<N>* m_obs;                    ///< null unless an adjoint is replaying
+    std::optional<LatentStage<N>> m_latent;    ///< Ĩa, Ĩc: absent for plain (RGB) rendering
+    const bool m_emission;                     ///< Ĩe on
+    /// Latent renders keep zero-valued NEE samples and zero-throughput paths: their derivatives
+    /// need not be zero. Decided by what is rendered, never by whether an observer listens.
+    const bool m_keep_zero;
     std::vector<Lambertian> m_lambertian;  ///< per shape: sampled from the batch-warped direction
 };
 

@@ -7,6 +7,7 @@
 #include "core/sampler.h"
 #include "core/scene.h"
 #include "core/scene_spectra.h"
+#include "integrators/path_events.h"
 #include "integrators/path_observer.h"
 #include <cstdint>
 #include <functional>
@@ -44,10 +45,6 @@ struct RenderStats {
 template <int N>
 Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& options, RenderStats* stats = nullptr);
 
-/// Ĩc's gate at the first non-delta vertex: add L̃c where the light sample is blocked (the
-/// paper's prose and public code; default) or where it is visible (the paper's equation, V).
-enum class OcclusionGate { Shadowed, Visible };
-
 /// The latent renderer's terms beyond light transport (docs/transport.md, latent section).
 template <int N>
 struct LatentTerms {
@@ -65,8 +62,9 @@ struct TermFilms {
 
 /// One pass that renders the three latent terms with the same paths (common random numbers).
 /// With an observer, every path also reports its events (the adjoint's replay); the observer must
-/// be safe to call from several threads for different tiles. Zero-valued NEE samples and
-/// zero-throughput bounces are then kept, since their derivatives need not be zero.
+/// be safe to call from several threads for different tiles. An observer never changes what is
+/// rendered: latent renders always keep zero-valued NEE samples and zero-throughput bounces,
+/// since their derivatives need not be zero (RGB renders drop them).
 template <int N>
 TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
                                  const RenderOptions& options, RenderStats* stats = nullptr, PathObserver<N>* observer = nullptr);

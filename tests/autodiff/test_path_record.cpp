@@ -153,3 +153,24 @@ TEST(PathRecorder, TwoRecordersOnOneThreadKeepTheirOwnEvents) {
     ASSERT_EQ(rb.events.size(), 2u);
     EXPECT_EQ(rb.events[1].shape, 8);
 }
+
+// Attaching the recorder must not change what the primal renders or traces: with a reflectance at
+// exactly zero (whose derivative is not zero), the latent render keeps those paths either way.
+TEST(PathRecord, AnObserverDoesNotChangeThePrimal) {
+    Scene scene = mixed_cornell();
+    LatentModel m(scene, Parameterisation::Paper, 3);
+    const int floor = scene.find_shape("floor");
+    ASSERT_FALSE(m.slots(floor).bsdf.empty());
+    const std::vector<float> zero(kLatentChannels, 0.f);
+    m.params().set_value(m.slots(floor).bsdf.front().second, zero.data());
+    m.sync();
+    const RenderOptions o = opts(scene);
+    RenderStats plain_stats, recorded_stats;
+    const std::vector<float> plain = render_latent_terms<kLatentChannels>(scene, m.spectra(), m.terms(), o, &plain_stats).sum();
+    std::vector<float> recorded;
+    record_latent_paths(m, o, &recorded, &recorded_stats);
+    ASSERT_EQ(plain.size(), recorded.size());
+    for (size_t i = 0; i < plain.size(); ++i) ASSERT_EQ(plain[i], recorded[i]) << "value " << i;
+    EXPECT_EQ(plain_stats.shadow_rays, recorded_stats.shadow_rays);
+    EXPECT_EQ(plain_stats.extension_rays, recorded_stats.extension_rays);
+}

@@ -1,0 +1,54 @@
+// Ĩa and Ĩc, the latent renderer's terms beyond light transport, as a stage of the tracer of its
+// own. The light-transport stages call it at the three points of a path where the terms are
+// decided (an escape, a surface hit, the first vertex's light sample) and do not know what it
+// adds; an RGB render has none. docs/transport.md (5)–(7).
+#pragma once
+#include "integrators/path.h"
+#include "integrators/path_events.h"
+#include "integrators/wavefront_state.h"
+
+namespace lpt {
+
+template <int N>
+class LatentStage {
+public:
+    LatentStage(const LatentTerms<N>& terms, PathObserver<N>* observer) : m_terms(terms), m_obs(observer) {}
+
+    /// Ĩe is rendered (else transport stops at the first non-delta vertex).
+    bool emission() const { return m_terms.emission; }
+
+    /// A path escaped: the background joins Ĩa unless a non-delta vertex came before.
+    void escaped(PathState<N>& p, uint32_t slot) const {
+        if (!m_terms.ambient || p.past_first[slot]) return;
+        p.ambient[slot] += ambient_score(p.beta[slot], m_terms.background);
+        if (m_obs) m_obs->ambient(slot, -1);
+    }
+
+    /// A path reached a vertex of `shape`. At its first non-delta vertex: Ĩa, and true when that
+    /// vertex's light sample is to decide Ĩc.
+    bool hit(PathState<N>& p, uint32_t slot, int shape, bool delta) const {
+        if (p.past_first[slot] || delta) return false;
+        p.past_first[slot] = 1;
+        if (m_terms.ambient) {
+            p.ambient[slot] += ambient_score(p.beta[slot], m_terms.La[shape]);
+            if (m_obs) m_obs->ambient(slot, shape);
+        }
+        return m_terms.occlusion;
+    }
+
+    /// Ĩc's candidate at the first vertex of `shape`, held until its light sample's visibility is known.
+    Spectrum<N> occlusion(const PathState<N>& p, uint32_t slot, int shape) const {
+        return occlusion_score(p.beta[slot], m_terms.Lc[shape]);
+    }
+
+    /// The light sample's visibility is known: the candidate counts if it passes the gate.
+    void gate(PathState<N>& p, uint32_t slot, const Spectrum<N>& candidate, bool visible) const {
+        if (occlusion_gate_passes(m_terms.gate, visible)) p.occlusion[slot] += candidate;
+    }
+
+private:
+    const LatentTerms<N>& m_terms;
+    PathObserver<N>* m_obs;
+};
+
+}  // namespace lpt
