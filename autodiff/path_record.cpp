@@ -171,8 +171,8 @@ L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, SamplerId
     return bsdf.eval(context_of(e), e.wi, e.wo) / e.pdf;
 }
 
-/// Throughput in front of each event (beta) and each event's local factor (local): visible NEE
-/// f·w/p, bounce weight/q. docs/path-replay.md (1).
+/// Throughput in front of each event (beta) and each event's local factor (local): a visible
+/// NEE sample's BSDF value f, a bounce's weight/q. docs/path-replay.md (1).
 void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint32_t sample, const PathEvent* ev, size_t n, PathScratch& s) {
     if (s.beta.size() < n) {
         s.beta.resize(n);
@@ -183,7 +183,7 @@ void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint
         const PathEvent& e = ev[i];
         s.beta[i] = beta;
         if (e.type == PathEvent::Light && (e.flags & PathEvent::kNee) && (e.flags & PathEvent::kVisible)) {
-            s.local[i] = m.spectra().bsdf_of(m.scene(), e.shape).eval(context_of(e), e.wi, e.wo) * e.w_over_pdf;
+            s.local[i] = m.spectra().bsdf_of(m.scene(), e.shape).eval(context_of(e), e.wi, e.wo);
         } else if (e.type == PathEvent::Bounce) {
             s.local[i] = bounce_weight(m.spectra().bsdf_of(m.scene(), e.shape), e, sampler, pixel, sample) / e.survival;
             beta *= s.local[i];
@@ -192,9 +192,10 @@ void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint
 }
 
 bool gate_open(const LatentModel& m, const PathEvent& e) {
-    const bool visible = (e.flags & PathEvent::kVisible) != 0;
-    return (e.flags & PathEvent::kFirst) && visible != (m.terms().gate == OcclusionGate::Shadowed);
+    return (e.flags & PathEvent::kFirst) && occlusion_gate_passes(m.terms().gate, (e.flags & PathEvent::kVisible) != 0);
 }
+
+bool visible_nee(const PathEvent& e) { return (e.flags & PathEvent::kNee) && (e.flags & PathEvent::kVisible); }
 
 int emitter_slice(const LatentModel& m, int emitter) {
     if (emitter == m.scene().environment) return m.environment_slot();
@@ -229,28 +230,29 @@ void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& bl
             const auto& sc = m.slots(shape).scalar;
             if (!sc.empty()) g[ps.slice(sc[0].second).value_offset] += v.sum();
         };
-        L R = L::Zero();  // docs/path-replay.md (3)
+        L R = L::Zero();  // docs/path-replay.md (3): what the events after i add, with β = 1 at i
+        const L one = L::Ones();
         for (size_t i = n; i-- > 0;) {
             const PathEvent& e = ev[i];
             const L& beta = s.beta[i];
             switch (e.type) {
                 case PathEvent::Emission:
-                    R += e.mis * radiance[e.emitter];
+                    R += emission_score(one, e.mis, radiance[e.emitter]);
                     add(emitter_slice(m, e.emitter), d * beta * e.mis);
                     break;
                 case PathEvent::Ambient:
-                    R += e.shape < 0 ? terms.background : terms.La[e.shape];
+                    R += ambient_score(one, e.shape < 0 ? terms.background : terms.La[e.shape]);
                     add(e.shape < 0 ? m.background_slot() : m.slots(e.shape).La, d * beta);
                     break;
                 case PathEvent::Light: {
                     if (gate_open(m, e)) {
-                        R += terms.Lc[e.shape];
+                        R += occlusion_score(one, terms.Lc[e.shape]);
                         add(m.slots(e.shape).Lc, d * beta);
                     }
-                    if (!(e.flags & PathEvent::kNee) || !(e.flags & PathEvent::kVisible)) break;
+                    if (!visible_nee(e)) break;
                     const L& le = radiance[e.emitter];
-                    R += s.local[i] * le;
-                    add(emitter_slice(m, e.emitter), d * beta * s.local[i]);
+                    R += nee_score(one, s.local[i], le, e.w_over_pdf);
+                    add(emitter_slice(m, e.emitter), d * beta * s.local[i] * e.w_over_pdf);
                     const BSDF<kLatentChannels>& bsdf = m.spectra().bsdf_of(m.scene(), e.shape);
                     const BSDFContext ctx = context_of(e);
                     const auto& keys = m.slots(e.shape).bsdf;
@@ -309,12 +311,12 @@ std::vector<float> replay_forward(const LatentModel& m, const PathRecords& r) {
                     const PathEvent& e = ev[i];
                     const L& beta = s.beta[i];
                     if (e.type == PathEvent::Emission) {
-                        e_sum += beta * (e.mis * radiance[e.emitter]);
+                        e_sum += emission_score(beta, e.mis, radiance[e.emitter]);
                     } else if (e.type == PathEvent::Ambient) {
-                        a_sum += beta * (e.shape < 0 ? terms.background : terms.La[e.shape]);
+                        a_sum += ambient_score(beta, e.shape < 0 ? terms.background : terms.La[e.shape]);
                     } else if (e.type == PathEvent::Light) {
-                        if (detail::gate_open(m, e)) c_sum += beta * terms.Lc[e.shape];
-                        if ((e.flags & PathEvent::kNee) && (e.flags & PathEvent::kVisible)) e_sum += beta * s.local[i] * radiance[e.emitter];
+                        if (detail::gate_open(m, e)) c_sum += occlusion_score(beta, terms.Lc[e.shape]);
+                        if (detail::visible_nee(e)) e_sum += nee_score(beta, s.local[i], radiance[e.emitter], e.w_over_pdf);
                     }
                 }
                 films.e.add_sample(int(block.pixel[k]), e_sum);
