@@ -55,6 +55,40 @@ void ratio_with_noise(double a, double var_a, double b, double var_b, double& ra
     sigma = (a != 0 && b != 0) ? std::abs(ratio) * std::sqrt(var_a / (a * a) + var_b / (b * b)) : 0.0;
 }
 
+/// One block's channel-average ratio with its noise; masked pixels left out.
+BlockComparison compare_block(const StackMoments& t, const StackMoments& r, const std::vector<uint8_t>& emitter_mask, int w, int h,
+                              int x0, int y0, int block_size, double z_threshold) {
+    BlockComparison b;
+    b.x0 = x0;
+    b.y0 = y0;
+    b.width = std::min(block_size, w - b.x0);
+    b.height = std::min(block_size, h - b.y0);
+    double vt = 0, vr = 0;
+    for (int y = b.y0; y < b.y0 + b.height; ++y) {
+        for (int x = b.x0; x < b.x0 + b.width; ++x) {
+            const size_t p = size_t(y) * size_t(w) + size_t(x);
+            if (!emitter_mask.empty() && emitter_mask[p] != 0) continue;
+            ++b.pixels;
+            for (int ch = 0; ch < 3; ++ch) {
+                b.test_mean += t.mean[p * 3 + ch] / 3.0;
+                b.ref_mean += r.mean[p * 3 + ch] / 3.0;
+            }
+            vt += t.var_grey[p];
+            vr += r.var_grey[p];
+        }
+    }
+    if (b.pixels == 0) return b;
+    const double ib = 1.0 / double(b.pixels);
+    b.test_mean *= ib;
+    b.ref_mean *= ib;
+    ratio_with_noise(b.test_mean, vt * ib * ib, b.ref_mean, vr * ib * ib, b.ratio, b.sigma);
+    b.z = b.sigma > 0 ? (b.ratio - 1.0) / b.sigma : 0.0;
+    // With no noise known on either side every difference would look significant: nothing is
+    // flagged, and the report says why.
+    b.flagged = b.sigma > 0 && std::abs(b.z) > z_threshold;
+    return b;
+}
+
 }  // namespace
 
 ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref, const std::vector<uint8_t>& emitter_mask,
@@ -109,41 +143,11 @@ ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref,
     // Block ratios of the channel average with their noise (eq. (2)).
     c.blocks_x = (w + block_size - 1) / block_size;
     c.blocks_y = (h + block_size - 1) / block_size;
-    for (int by = 0; by < c.blocks_y; ++by) {
+    for (int by = 0; by < c.blocks_y; ++by)
         for (int bx = 0; bx < c.blocks_x; ++bx) {
-            BlockComparison b;
-            b.x0 = bx * block_size;
-            b.y0 = by * block_size;
-            b.width = std::min(block_size, w - b.x0);
-            b.height = std::min(block_size, h - b.y0);
-            double vt = 0, vr = 0;
-            for (int y = b.y0; y < b.y0 + b.height; ++y) {
-                for (int x = b.x0; x < b.x0 + b.width; ++x) {
-                    const size_t p = size_t(y) * size_t(w) + size_t(x);
-                    if (masked(p)) continue;
-                    ++b.pixels;
-                    for (int ch = 0; ch < 3; ++ch) {
-                        b.test_mean += t.mean[p * 3 + ch] / 3.0;
-                        b.ref_mean += r.mean[p * 3 + ch] / 3.0;
-                    }
-                    vt += t.var_grey[p];
-                    vr += r.var_grey[p];
-                }
-            }
-            if (b.pixels > 0) {
-                const double ib = 1.0 / double(b.pixels);
-                b.test_mean *= ib;
-                b.ref_mean *= ib;
-                ratio_with_noise(b.test_mean, vt * ib * ib, b.ref_mean, vr * ib * ib, b.ratio, b.sigma);
-                b.z = b.sigma > 0 ? (b.ratio - 1.0) / b.sigma : 0.0;
-                // With no noise known on either side every difference would look significant:
-                // nothing is flagged, and the report says why.
-                b.flagged = b.sigma > 0 && std::abs(b.z) > z_threshold;
-                c.flagged += b.flagged ? 1 : 0;
-            }
-            c.blocks.push_back(b);
+            c.blocks.push_back(compare_block(t, r, emitter_mask, w, h, bx * block_size, by * block_size, block_size, z_threshold));
+            c.flagged += c.blocks.back().flagged ? 1 : 0;
         }
-    }
     return c;
 }
 

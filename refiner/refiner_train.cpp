@@ -39,6 +39,145 @@ void put_params(torch::nn::Module& net, const ParamCopy& c) {
 
 constexpr double kSmoothing = 0.98;  // EMA of the crop loss: crops differ, the smoothed loss decides
 
+/// Everything a training run carries from one iteration to the next, and its checkpoint.
+struct TrainingState {
+    torch::optim::Adam adam;
+    RefinerTrainResult result;
+    EarlyStopping stop;
+    ParamCopy best;
+    int start = 0;
+    double smoothed = 0;
+
+    TrainingState(RefinerNet& net, const RefinerTrainOptions& o)
+        : adam(net->parameters(), torch::optim::AdamOptions(o.lr)), stop(std::max(1, o.patience), o.min_delta), best(copy_params(*net)) {}
+};
+
+void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, TrainingState& s) {
+    if (path.empty() || !std::filesystem::exists(path)) throw std::runtime_error("refiner: --resume but no checkpoint at '" + path + "'");
+    try {
+        torch::serialize::InputArchive ar, net_ar, best_ar, adam_ar;
+        ar.load_from(path);
+        ar.read("net", net_ar);
+        net->load(net_ar);
+        ar.read("best", best_ar);
+        {
+            RefinerNet tmp(cfg);
+            tmp->load(best_ar);
+            s.best = copy_params(*tmp);
+        }
+        ar.read("adam", adam_ar);
+        s.adam.load(adam_ar);
+        torch::Tensor hist;
+        ar.read("history", hist);
+        for (int64_t i = 0; i < hist.size(0); ++i) {
+            auto r = hist[i];
+            s.result.history.push_back({int(r[0].item<double>()), r[1].item<double>(), r[2].item<double>(), r[3].item<double>(),
+                                        r[4].item<double>(), r[5].item<double>(), r[6].item<double>()});
+        }
+        torch::Tensor st;
+        ar.read("stop", st);
+        s.stop.restore(st[0].item<double>(), int(st[1].item<double>()), int(st[2].item<double>()));
+    } catch (const c10::Error& e) {
+        throw std::runtime_error(path + ": cannot read refiner checkpoint: " + e.what_without_backtrace());
+    }
+    s.start = s.result.history.empty() ? 0 : s.result.history.back().iteration + 1;
+    s.smoothed = s.result.history.empty() ? 0 : s.result.history.back().smoothed;
+}
+
+/// Written to a temporary file and renamed: a killed run never leaves half a checkpoint.
+void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, TrainingState& s) {
+    if (path.empty()) return;
+    torch::serialize::OutputArchive ar, net_ar, best_ar, adam_ar;
+    net->save(net_ar);
+    ar.write("net", net_ar);
+    RefinerNet tmp(cfg);
+    put_params(*tmp, s.best);
+    tmp->save(best_ar);
+    ar.write("best", best_ar);
+    s.adam.save(adam_ar);
+    ar.write("adam", adam_ar);
+    torch::Tensor hist = torch::zeros({int64_t(s.result.history.size()), 7}, torch::kFloat64);
+    for (size_t i = 0; i < s.result.history.size(); ++i) {
+        const RefinerRecord& r = s.result.history[i];
+        const double v[7] = {double(r.iteration), r.loss, r.smoothed, r.mse, r.dssim, r.lpips, r.seconds};
+        for (int k = 0; k < 7; ++k) hist[int64_t(i)][k] = v[k];
+    }
+    ar.write("history", hist);
+    ar.write("stop", torch::tensor({s.stop.best_loss(), double(s.stop.best_iteration()), double(s.stop.bad_updates())}, torch::kFloat64));
+    const std::string tmp_path = path + ".tmp";
+    ar.save_to(tmp_path);
+    std::filesystem::rename(tmp_path, path);
+}
+
+/// The training view as tensors and what each iteration's loss uses.
+struct TrainingData {
+    torch::Tensor x_all, y_all, rgb_all;  ///< inputs, target latent, target RGB (may be undefined)
+    const TorchVae* vae = nullptr;
+    const Lpips* lpips = nullptr;
+    int w = 0, h = 0, crop_w = 0, crop_h = 0, lp = 0;
+    bool use_lpips = false, use_ssim = false;
+};
+
+TrainingData training_data(const RefinerInput& input, const RefinerConfig& cfg, const std::vector<float>& target,
+                           const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips, const RefinerTrainOptions& o) {
+    TrainingData d;
+    d.w = input.width;
+    d.h = input.height;
+    const int w = d.w, h = d.h, c = cfg.latent_channels;
+    d.x_all = refiner_input_tensor(input, cfg);
+    if (int64_t(target.size()) != int64_t(w) * h * c)
+        throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c));
+    d.y_all = torch::from_blob(const_cast<float*>(target.data()), {1, h, w, c}).permute({0, 3, 1, 2}).contiguous();
+    if (target_rgb) {
+        if (int64_t(target_rgb->size()) != int64_t(64) * w * h * 3) throw std::invalid_argument("refiner: target RGB must be 8w x 8h x 3");
+        d.rgb_all = torch::from_blob(const_cast<float*>(target_rgb->data()), {1, 8 * h, 8 * w, 3}).permute({0, 3, 1, 2}).contiguous();
+    }
+    d.vae = vae ? torch_vae(*vae) : nullptr;
+    d.lpips = lpips;
+    d.crop_w = o.crop > 0 ? std::min(o.crop, w) : w;
+    d.crop_h = o.crop > 0 ? std::min(o.crop, h) : h;
+    d.lp = std::min({o.lpips_crop, d.crop_w, d.crop_h});
+    d.use_lpips = d.vae && lpips && o.w_lpips > 0.f && d.lp > 0 && 8 * d.lp >= Lpips::kMinSize;
+    d.use_ssim = o.w_ssim > 0.f && d.crop_w >= kSsimWindow && d.crop_h >= kSsimWindow;
+    return d;
+}
+
+/// Iteration `it`'s loss on its crop (w·MSE + w·D-SSIM + w·LPIPS of a decoded sub-crop); the
+/// record receives the parts.
+torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTrainOptions& o, int it, RefinerRecord& r) {
+    const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
+    torch::manual_seed(key);  // dropout masks
+    const int cx = pick(key + 1, d.w - d.crop_w), cy = pick(key + 2, d.h - d.crop_h);
+    torch::Tensor x = d.x_all.narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
+    torch::Tensor y = d.y_all.narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
+    torch::Tensor out = net->forward(x);
+    torch::Tensor mse = torch::mse_loss(out, y);
+    torch::Tensor loss = o.w_mse * mse;
+    r.iteration = it;
+    r.mse = mse.item<double>();
+    if (d.use_ssim) {
+        torch::Tensor dssim = 1.0 - ssim_torch(out, y, kLatentDataRange).mean();
+        loss = loss + o.w_ssim * dssim;
+        r.dssim = dssim.item<double>();
+    }
+    if (d.use_lpips) {
+        const int lp = d.lp, lx = pick(key + 3, d.crop_w - lp), ly = pick(key + 4, d.crop_h - lp);
+        torch::Tensor dec = d.vae->decode_nchw(out.narrow(2, ly, lp).narrow(3, lx, lp));
+        torch::Tensor ref;
+        if (d.rgb_all.defined()) {
+            ref = d.rgb_all.narrow(2, 8 * (cy + ly), 8 * lp).narrow(3, 8 * (cx + lx), 8 * lp);
+        } else {
+            torch::NoGradGuard no_grad;
+            ref = d.vae->decode_nchw(y.narrow(2, ly, lp).narrow(3, lx, lp));
+        }
+        torch::Tensor dist = lpips_torch(d.lpips->net(), dec * 2.0 - 1.0, ref * 2.0 - 1.0).mean();
+        loss = loss + o.w_lpips * dist;
+        r.lpips = dist.item<double>();
+    }
+    r.loss = loss.item<double>();
+    return loss;
+}
+
 }  // namespace
 
 RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<float>& target, const std::vector<float>* target_rgb,
@@ -46,139 +185,35 @@ RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<f
                                   const std::function<bool(const RefinerRecord&)>& on_iteration) {
     RefinerNet& net = m->net;
     const RefinerConfig& cfg = m->config;
-    const int w = input.width, h = input.height, c = cfg.latent_channels;
-    torch::Tensor x_all = refiner_input_tensor(input, cfg);
-    if (int64_t(target.size()) != int64_t(w) * h * c)
-        throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c));
-    torch::Tensor y_all = torch::from_blob(const_cast<float*>(target.data()), {1, h, w, c}).permute({0, 3, 1, 2}).contiguous();
-    torch::Tensor rgb_all;
-    if (target_rgb) {
-        if (int64_t(target_rgb->size()) != int64_t(64) * w * h * 3) throw std::invalid_argument("refiner: target RGB must be 8w x 8h x 3");
-        rgb_all = torch::from_blob(const_cast<float*>(target_rgb->data()), {1, 8 * h, 8 * w, 3}).permute({0, 3, 1, 2}).contiguous();
-    }
-    const TorchVae* tvae = vae ? torch_vae(*vae) : nullptr;
-    const int crop_w = o.crop > 0 ? std::min(o.crop, w) : w, crop_h = o.crop > 0 ? std::min(o.crop, h) : h;
-    const int lp = std::min({o.lpips_crop, crop_w, crop_h});
-    const bool use_lpips = tvae && lpips && o.w_lpips > 0.f && lp > 0 && 8 * lp >= Lpips::kMinSize;
-    const bool use_ssim = o.w_ssim > 0.f && crop_w >= kSsimWindow && crop_h >= kSsimWindow;
-
-    torch::optim::Adam adam(net->parameters(), torch::optim::AdamOptions(o.lr));
-    RefinerTrainResult result;
-    int start = 0;
-    double smoothed = 0;
-    EarlyStopping stop(std::max(1, o.patience), o.min_delta);
-    ParamCopy best = copy_params(*net);
-    if (o.resume) {
-        if (o.checkpoint_path.empty() || !std::filesystem::exists(o.checkpoint_path))
-            throw std::runtime_error("refiner: --resume but no checkpoint at '" + o.checkpoint_path + "'");
-        try {
-            torch::serialize::InputArchive ar, net_ar, best_ar, adam_ar;
-            ar.load_from(o.checkpoint_path);
-            ar.read("net", net_ar);
-            net->load(net_ar);
-            ar.read("best", best_ar);
-            {
-                RefinerNet tmp(cfg);
-                tmp->load(best_ar);
-                best = copy_params(*tmp);
-            }
-            ar.read("adam", adam_ar);
-            adam.load(adam_ar);
-            torch::Tensor hist;
-            ar.read("history", hist);
-            for (int64_t i = 0; i < hist.size(0); ++i) {
-                auto r = hist[i];
-                result.history.push_back({int(r[0].item<double>()), r[1].item<double>(), r[2].item<double>(), r[3].item<double>(),
-                                          r[4].item<double>(), r[5].item<double>(), r[6].item<double>()});
-            }
-            torch::Tensor st;
-            ar.read("stop", st);
-            stop.restore(st[0].item<double>(), int(st[1].item<double>()), int(st[2].item<double>()));
-        } catch (const c10::Error& e) {
-            throw std::runtime_error(o.checkpoint_path + ": cannot read refiner checkpoint: " + e.what_without_backtrace());
-        }
-        start = result.history.empty() ? 0 : result.history.back().iteration + 1;
-        smoothed = result.history.empty() ? 0 : result.history.back().smoothed;
-    }
-    auto save_checkpoint = [&]() {
-        if (o.checkpoint_path.empty()) return;
-        torch::serialize::OutputArchive ar, net_ar, best_ar, adam_ar;
-        net->save(net_ar);
-        ar.write("net", net_ar);
-        RefinerNet tmp(cfg);
-        put_params(*tmp, best);
-        tmp->save(best_ar);
-        ar.write("best", best_ar);
-        adam.save(adam_ar);
-        ar.write("adam", adam_ar);
-        torch::Tensor hist = torch::zeros({int64_t(result.history.size()), 7}, torch::kFloat64);
-        for (size_t i = 0; i < result.history.size(); ++i) {
-            const RefinerRecord& r = result.history[i];
-            const double v[7] = {double(r.iteration), r.loss, r.smoothed, r.mse, r.dssim, r.lpips, r.seconds};
-            for (int k = 0; k < 7; ++k) hist[int64_t(i)][k] = v[k];
-        }
-        ar.write("history", hist);
-        ar.write("stop", torch::tensor({stop.best_loss(), double(stop.best_iteration()), double(stop.bad_updates())}, torch::kFloat64));
-        const std::string tmp_path = o.checkpoint_path + ".tmp";
-        ar.save_to(tmp_path);
-        std::filesystem::rename(tmp_path, o.checkpoint_path);
-    };
-
-    const double seconds_before = result.history.empty() ? 0.0 : result.history.back().seconds;
+    const TrainingData data = training_data(input, cfg, target, target_rgb, vae, lpips, o);
+    TrainingState s(net, o);
+    if (o.resume) load_checkpoint(o.checkpoint_path, net, cfg, s);
+    const double seconds_before = s.result.history.empty() ? 0.0 : s.result.history.back().seconds;
     const auto t0 = std::chrono::steady_clock::now();
-    bool stopped = o.patience > 0 && stop.bad_updates() >= o.patience;
-    for (int it = start; it < o.iterations && !stopped; ++it) {
-        const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
-        torch::manual_seed(key);  // dropout masks
-        const int cx = pick(key + 1, w - crop_w), cy = pick(key + 2, h - crop_h);
-        torch::Tensor x = x_all.narrow(2, cy, crop_h).narrow(3, cx, crop_w);
-        torch::Tensor y = y_all.narrow(2, cy, crop_h).narrow(3, cx, crop_w);
+    bool stopped = o.patience > 0 && s.stop.bad_updates() >= o.patience;
+    for (int it = s.start; it < o.iterations && !stopped; ++it) {
         net->train();
-        adam.zero_grad();
-        torch::Tensor out = net->forward(x);
-        torch::Tensor mse = torch::mse_loss(out, y);
-        torch::Tensor loss = o.w_mse * mse;
+        s.adam.zero_grad();
         RefinerRecord r;
-        r.iteration = it;
-        r.mse = mse.item<double>();
-        if (use_ssim) {
-            torch::Tensor dssim = 1.0 - ssim_torch(out, y, kLatentDataRange).mean();
-            loss = loss + o.w_ssim * dssim;
-            r.dssim = dssim.item<double>();
-        }
-        if (use_lpips) {
-            const int lx = pick(key + 3, crop_w - lp), ly = pick(key + 4, crop_h - lp);
-            torch::Tensor dec = tvae->decode_nchw(out.narrow(2, ly, lp).narrow(3, lx, lp));
-            torch::Tensor ref;
-            if (rgb_all.defined()) {
-                ref = rgb_all.narrow(2, 8 * (cy + ly), 8 * lp).narrow(3, 8 * (cx + lx), 8 * lp);
-            } else {
-                torch::NoGradGuard no_grad;
-                ref = tvae->decode_nchw(y.narrow(2, ly, lp).narrow(3, lx, lp));
-            }
-            torch::Tensor d = lpips_torch(lpips->net(), dec * 2.0 - 1.0, ref * 2.0 - 1.0).mean();
-            loss = loss + o.w_lpips * d;
-            r.lpips = d.item<double>();
-        }
-        r.loss = loss.item<double>();
+        torch::Tensor loss = crop_loss(net, data, o, it, r);
         if (!std::isfinite(r.loss)) throw std::runtime_error("refiner: loss became non-finite at iteration " + std::to_string(it));
         loss.backward();
-        adam.step();
-        smoothed = it == 0 ? r.loss : kSmoothing * smoothed + (1 - kSmoothing) * r.loss;
-        r.smoothed = smoothed;
+        s.adam.step();
+        s.smoothed = it == 0 ? r.loss : kSmoothing * s.smoothed + (1 - kSmoothing) * r.loss;
+        r.smoothed = s.smoothed;
         r.seconds = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        result.history.push_back(r);
-        const bool should_stop = stop.update(smoothed, it);
-        if (stop.improved()) best = copy_params(*net);
+        s.result.history.push_back(r);
+        const bool should_stop = s.stop.update(s.smoothed, it);
+        if (s.stop.improved()) s.best = copy_params(*net);
         if (o.patience > 0 && should_stop) stopped = true;
-        if (o.checkpoint_every > 0 && (it + 1) % o.checkpoint_every == 0) save_checkpoint();
+        if (o.checkpoint_every > 0 && (it + 1) % o.checkpoint_every == 0) save_checkpoint(o.checkpoint_path, net, cfg, s);
         if (on_iteration && !on_iteration(r)) break;
     }
-    save_checkpoint();
-    put_params(*net, best);
-    result.best_iteration = stop.best_iteration();
-    result.best_loss = stop.best_loss();
-    return result;
+    save_checkpoint(o.checkpoint_path, net, cfg, s);
+    put_params(*net, s.best);
+    s.result.best_iteration = s.stop.best_iteration();
+    s.result.best_loss = s.stop.best_loss();
+    return s.result;
 }
 
 }  // namespace lpt

@@ -207,6 +207,80 @@ int find_prop(const PlyElement& e, const char* name) {
     return -1;
 }
 
+
+/// The vertex element: positions, and normals and uvs where all their properties are present.
+void read_vertices(const std::string& path, const PlyElement& e, PlyBody& body, size_t reserve, TriangleMesh& mesh) {
+    int ix = find_prop(e, "x"), iy = find_prop(e, "y"), iz = find_prop(e, "z");
+    if (ix < 0 || iy < 0 || iz < 0) throw SceneError(path, "", "element 'vertex' lacks one of the properties x, y, z");
+    int in[3] = {find_prop(e, "nx"), find_prop(e, "ny"), find_prop(e, "nz")};
+    bool has_n = in[0] >= 0 && in[1] >= 0 && in[2] >= 0;
+    int iu = -1, iv = -1;
+    const std::pair<const char*, const char*> uv_names[] = {{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
+    for (auto [u, v] : uv_names)
+        if (iu < 0 && find_prop(e, u) >= 0 && find_prop(e, v) >= 0) iu = find_prop(e, u), iv = find_prop(e, v);
+    for (int i : {ix, iy, iz, in[0], in[1], in[2], iu, iv})
+        if (i >= 0 && e.props[size_t(i)].is_list) throw SceneError(path, "", "vertex property '" + e.props[size_t(i)].name + "' is a list");
+    std::vector<double> values(e.props.size());
+    mesh.positions.reserve(reserve);
+    for (size_t r = 0; r < e.count; ++r) {
+        for (size_t k = 0; k < e.props.size(); ++k) {
+            const PlyProperty& p = e.props[k];
+            if (!p.is_list) {
+                values[k] = body.read(p.type, r);
+                continue;
+            }
+            double n = body.read(p.count_type, r);
+            for (double j = 0; j < n; ++j) body.read(p.type, r);
+        }
+        mesh.positions.emplace_back(float(values[ix]), float(values[iy]), float(values[iz]));
+        if (has_n) mesh.normals.emplace_back(float(values[in[0]]), float(values[in[1]]), float(values[in[2]]));
+        if (iu >= 0) mesh.uvs.emplace_back(float(values[iu]), float(values[iv]));
+    }
+}
+
+/// The face element: each polygon of its index list fan-triangulated.
+void read_faces(const std::string& path, const PlyElement& e, PlyBody& body, size_t reserve, TriangleMesh& mesh) {
+    int il = find_prop(e, "vertex_indices");
+    if (il < 0) il = find_prop(e, "vertex_index");
+    if (il < 0 || !e.props[size_t(il)].is_list)
+        throw SceneError(path, "", "element 'face' has no list property vertex_indices or vertex_index");
+    if (!is_integer(e.props[size_t(il)].type))
+        throw SceneError(path, "", "face property '" + e.props[size_t(il)].name + "' has a non-integer type");
+    mesh.indices.reserve(3 * reserve);
+    std::vector<uint32_t> poly;
+    for (size_t r = 0; r < e.count; ++r) {
+        for (size_t k = 0; k < e.props.size(); ++k) {
+            const PlyProperty& p = e.props[k];
+            if (!p.is_list) {
+                body.read(p.type, r);
+                continue;
+            }
+            double n = body.read(p.count_type, r);
+            if (int(k) != il) {
+                for (double j = 0; j < n; ++j) body.read(p.type, r);
+                continue;
+            }
+            if (n < 3) body.fail("a face with " + std::to_string(long(n)) + " vertices (needs 3)", r);
+            poly.clear();
+            for (double j = 0; j < n; ++j) {
+                double idx = body.read(p.type, r);
+                if (idx < 0 || idx > 4294967295.0)
+                    body.fail("vertex index " + std::to_string(static_cast<long long>(idx)) + " outside the 32-bit unsigned range", r);
+                poly.push_back(uint32_t(idx));
+            }
+            for (size_t j = 1; j + 1 < poly.size(); ++j) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[j], poly[j + 1]});
+        }
+    }
+}
+
+void skip_element(const PlyElement& e, PlyBody& body) {
+    for (size_t r = 0; r < e.count; ++r)
+        for (const PlyProperty& p : e.props) {
+            double n = p.is_list ? body.read(p.count_type, r) : 1.0;
+            for (double j = 0; j < n; ++j) body.read(p.type, r);
+        }
+}
+
 }  // namespace
 
 TriangleMesh load_ply(const std::string& path) {
@@ -219,73 +293,15 @@ TriangleMesh load_ply(const std::string& path) {
     for (const PlyElement& e : header.elements) {
         // Cap reservations by the bytes left so a bogus count cannot exhaust memory up front.
         const size_t reserve = std::min(e.count, body.remaining() / 2);
-        std::vector<double> values(e.props.size());
         body.begin_element(e);
         if (e.name == "vertex" && !have_vertex) {
             have_vertex = true;
-            int ix = find_prop(e, "x"), iy = find_prop(e, "y"), iz = find_prop(e, "z");
-            if (ix < 0 || iy < 0 || iz < 0)
-                throw SceneError(path, "", "element 'vertex' lacks one of the properties x, y, z");
-            int in[3] = {find_prop(e, "nx"), find_prop(e, "ny"), find_prop(e, "nz")};
-            bool has_n = in[0] >= 0 && in[1] >= 0 && in[2] >= 0;
-            int iu = -1, iv = -1;
-            const std::pair<const char*, const char*> uv_names[] = {
-                {"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
-            for (auto [u, v] : uv_names)
-                if (iu < 0 && find_prop(e, u) >= 0 && find_prop(e, v) >= 0) iu = find_prop(e, u), iv = find_prop(e, v);
-            for (int i : {ix, iy, iz, in[0], in[1], in[2], iu, iv})
-                if (i >= 0 && e.props[size_t(i)].is_list)
-                    throw SceneError(path, "", "vertex property '" + e.props[size_t(i)].name + "' is a list");
-            mesh.positions.reserve(reserve);
-            for (size_t r = 0; r < e.count; ++r) {
-                for (size_t k = 0; k < e.props.size(); ++k) {
-                    const PlyProperty& p = e.props[k];
-                    if (!p.is_list) { values[k] = body.read(p.type, r); continue; }
-                    double n = body.read(p.count_type, r);
-                    for (double j = 0; j < n; ++j) body.read(p.type, r);
-                }
-                mesh.positions.emplace_back(float(values[ix]), float(values[iy]), float(values[iz]));
-                if (has_n) mesh.normals.emplace_back(float(values[in[0]]), float(values[in[1]]), float(values[in[2]]));
-                if (iu >= 0) mesh.uvs.emplace_back(float(values[iu]), float(values[iv]));
-            }
+            read_vertices(path, e, body, reserve, mesh);
         } else if (e.name == "face" && !have_face) {
             have_face = true;
-            int il = find_prop(e, "vertex_indices");
-            if (il < 0) il = find_prop(e, "vertex_index");
-            if (il < 0 || !e.props[size_t(il)].is_list)
-                throw SceneError(path, "", "element 'face' has no list property vertex_indices or vertex_index");
-            if (!is_integer(e.props[size_t(il)].type))
-                throw SceneError(path, "", "face property '" + e.props[size_t(il)].name + "' has a non-integer type");
-            mesh.indices.reserve(3 * reserve);
-            std::vector<uint32_t> poly;
-            for (size_t r = 0; r < e.count; ++r) {
-                for (size_t k = 0; k < e.props.size(); ++k) {
-                    const PlyProperty& p = e.props[k];
-                    if (!p.is_list) { body.read(p.type, r); continue; }
-                    double n = body.read(p.count_type, r);
-                    if (int(k) != il) {
-                        for (double j = 0; j < n; ++j) body.read(p.type, r);
-                        continue;
-                    }
-                    if (n < 3) body.fail("a face with " + std::to_string(long(n)) + " vertices (needs 3)", r);
-                    poly.clear();
-                    for (double j = 0; j < n; ++j) {
-                        double idx = body.read(p.type, r);
-                        if (idx < 0 || idx > 4294967295.0)
-                            body.fail("vertex index " + std::to_string(static_cast<long long>(idx)) +
-                                          " outside the 32-bit unsigned range", r);
-                        poly.push_back(uint32_t(idx));
-                    }
-                    for (size_t j = 1; j + 1 < poly.size(); ++j)
-                        mesh.indices.insert(mesh.indices.end(), {poly[0], poly[j], poly[j + 1]});
-                }
-            }
+            read_faces(path, e, body, reserve, mesh);
         } else {
-            for (size_t r = 0; r < e.count; ++r)
-                for (const PlyProperty& p : e.props) {
-                    double n = p.is_list ? body.read(p.count_type, r) : 1.0;
-                    for (double j = 0; j < n; ++j) body.read(p.type, r);
-                }
+            skip_element(e, body);
         }
     }
     if (!have_vertex) throw SceneError(path, "", "no element 'vertex'");

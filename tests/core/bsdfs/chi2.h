@@ -79,6 +79,44 @@ inline Vec3f sphere_dir(double theta, double phi) {
     return Vec3f(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)));
 }
 
+/// Pearson's chi-square of observed against expected cell counts (cells of expected < 5 pooled);
+/// cell n_cells holds the samples outside the density.
+inline Chi2Result chi2_from_counts(const std::vector<double>& observed, const std::vector<double>& expected, int n_cells, int n_samples,
+                                   double total, double significance) {
+    Chi2Result r;
+    std::ostringstream msg;
+    msg << "integral of pdf = " << total << ", samples outside the density = " << observed[n_cells] << "/" << n_samples;
+    std::vector<int> order(n_cells + 1);
+    for (int i = 0; i <= n_cells; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return expected[a] < expected[b]; });
+    double pool_obs = 0.0, pool_exp = 0.0;
+    for (int i : order) {
+        if (i < n_cells && expected[i] == 0.0 && observed[i] > 0.0) {
+            msg << "; " << observed[i] << " samples in cell " << i << " of zero density";
+            r.summary = msg.str();
+            return r;
+        }
+        if (expected[i] < 5.0 || (pool_exp > 0.0 && pool_exp < 5.0)) {
+            pool_obs += observed[i];
+            pool_exp += expected[i];
+        } else {
+            r.statistic += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
+            ++r.dof;
+        }
+    }
+    if (pool_exp > 0.0) {
+        r.statistic += (pool_obs - pool_exp) * (pool_obs - pool_exp) / pool_exp;
+        ++r.dof;
+    }
+    r.dof -= 1;
+    r.p_value = r.dof > 0 ? gamma_q(0.5 * r.dof, 0.5 * r.statistic) : 1.0;
+    r.passed = r.p_value >= significance;
+    msg << "; chi2 = " << r.statistic << ", dof = " << r.dof << ", p = " << r.p_value
+        << " (needs >= " << significance << ")";
+    r.summary = msg.str();
+    return r;
+}
+
 /// sample(): the next direction, or nullopt for a sample outside the tested density.
 /// pdf(w): solid-angle density of the tested part. Quadrature nodes lie strictly inside cells,
 /// so density jumps at the horizon (a cell edge) are harmless.
@@ -133,38 +171,7 @@ Chi2Result chi2_sphere_test(SampleFn&& sample, PdfFn&& pdf, int n_samples, doubl
         }
     expected[n_cells] = std::max(0.0, 1.0 - total) * n_samples;
 
-    Chi2Result r;
-    std::ostringstream msg;
-    msg << "integral of pdf = " << total << ", samples outside the density = " << observed[n_cells] << "/" << n_samples;
-    std::vector<int> order(n_cells + 1);
-    for (int i = 0; i <= n_cells; ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return expected[a] < expected[b]; });
-    double pool_obs = 0.0, pool_exp = 0.0;
-    for (int i : order) {
-        if (i < n_cells && expected[i] == 0.0 && observed[i] > 0.0) {
-            msg << "; " << observed[i] << " samples in cell " << i << " of zero density";
-            r.summary = msg.str();
-            return r;
-        }
-        if (expected[i] < 5.0 || (pool_exp > 0.0 && pool_exp < 5.0)) {
-            pool_obs += observed[i];
-            pool_exp += expected[i];
-        } else {
-            r.statistic += (observed[i] - expected[i]) * (observed[i] - expected[i]) / expected[i];
-            ++r.dof;
-        }
-    }
-    if (pool_exp > 0.0) {
-        r.statistic += (pool_obs - pool_exp) * (pool_obs - pool_exp) / pool_exp;
-        ++r.dof;
-    }
-    r.dof -= 1;
-    r.p_value = r.dof > 0 ? gamma_q(0.5 * r.dof, 0.5 * r.statistic) : 1.0;
-    r.passed = r.p_value >= significance;
-    msg << "; chi2 = " << r.statistic << ", dof = " << r.dof << ", p = " << r.p_value
-        << " (needs >= " << significance << ")";
-    r.summary = msg.str();
-    return r;
+    return chi2_from_counts(observed, expected, n_cells, n_samples, total, significance);
 }
 
 // ---- BSDF adapters ------------------------------------------------------------------------

@@ -80,6 +80,51 @@ TEST(BSDFParams, EveryCoefficientEntersAffinely) {
     }
 }
 
+/// eval_grad (at random wo and at sampled wo) and weight_grad of coefficient `key` against central
+/// differences between coefficient values cp and cm (`step` = cp - cm), at 64 directions.
+static void expect_gradients_match(BSDF<16>& b, const std::string& name, int key, const std::string& key_name, const Spectrum<16>& c,
+                            const Spectrum<16>& step, const Spectrum<16>& cp, const Spectrum<16>& cm, float tol) {
+    BSDF<16>* bsdf = &b;
+    int n_valid = 0;
+    for (uint32_t i = 0; i < 64; ++i) {
+        float z = (i % 2 ? 1.f : -1.f) * (0.2f + sample_1d(2, i, 0, 2));  // both faces
+        Vec3f wi = Vec3f(sample_1d(2, i, 0, 0) - 0.5f, sample_1d(2, i, 0, 1) - 0.5f, z).normalized();
+        float u1 = sample_1d(2, i, 0, 3);
+        Vec2f u2(sample_1d(2, i, 0, 4), sample_1d(2, i, 0, 5));
+        // eval_grad also off the sampler: wo uniform on the whole sphere.
+        float zr = 2.f * sample_1d(2, i, 0, 6) - 1.f, phi = 2.f * kPi * sample_1d(2, i, 0, 7);
+        float rr = std::sqrt(std::max(0.f, 1.f - zr * zr));
+        Vec3f wr(rr * std::cos(phi), rr * std::sin(phi), zr);
+        bsdf->set_spectral(key_name, c);
+        BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, u1, u2);
+        Spectrum<16> g_rand = bsdf->eval_grad(BSDFContext{}, wi, wr, key);
+        bsdf->set_spectral(key_name, cp);
+        Spectrum<16> rp = bsdf->eval(BSDFContext{}, wi, wr);
+        bsdf->set_spectral(key_name, cm);
+        Spectrum<16> rm = bsdf->eval(BSDFContext{}, wi, wr);
+        Spectrum<16> fd_rand = (rp - rm) / step;
+        EXPECT_LT((g_rand - fd_rand).abs().maxCoeff(), tol * (1.f + fd_rand.abs().maxCoeff()))
+            << name << " " << key_name << " random wo";
+        if (!bs.valid()) continue;
+        ++n_valid;
+        bsdf->set_spectral(key_name, c);
+        Spectrum<16> g_eval = bsdf->eval_grad(BSDFContext{}, wi, bs.wo, key);
+        Spectrum<16> g_weight = bsdf->weight_grad(BSDFContext{}, wi, bs, key);
+        bsdf->set_spectral(key_name, cp);
+        BSDFSample<16> bp = bsdf->sample(BSDFContext{}, wi, u1, u2);
+        Spectrum<16> ep = bsdf->eval(BSDFContext{}, wi, bs.wo);
+        bsdf->set_spectral(key_name, cm);
+        BSDFSample<16> bm = bsdf->sample(BSDFContext{}, wi, u1, u2);
+        Spectrum<16> em = bsdf->eval(BSDFContext{}, wi, bs.wo);
+        ASSERT_TRUE(bp.valid() && bm.valid() && bp.lobe == bs.lobe && bm.lobe == bs.lobe) << name;
+        Spectrum<16> fd_eval = (ep - em) / step, fd_weight = (bp.weight - bm.weight) / step;
+        EXPECT_LT((g_eval - fd_eval).abs().maxCoeff(), tol * (1.f + fd_eval.abs().maxCoeff())) << name << " " << key_name;
+        EXPECT_LT((g_weight - fd_weight).abs().maxCoeff(), tol * (1.f + fd_weight.abs().maxCoeff()))
+            << name << " " << key_name << " lobe " << bs.lobe;
+    }
+    EXPECT_GT(n_valid, 16) << name;  // the sampled branch was actually exercised
+}
+
 TEST(BSDFParams, CoefficientGradientsMatchFiniteDifferences) {
     const PropValue eta = Eigen::Array3f(0.2f, 0.9f, 1.1f), k = Eigen::Array3f(3.9f, 2.4f, 2.2f);
     const PropValue ggx = std::string("ggx");
@@ -130,44 +175,7 @@ TEST(BSDFParams, CoefficientGradientsMatchFiniteDifferences) {
             const float tol = key == cs.curved_key ? tol_curved : tol_affine;
             const Spectrum<16> cp = c + h, cm = c - h;
             const Spectrum<16> step = cp - cm;  // the exact float step, per channel
-            int n_valid = 0;
-            for (uint32_t i = 0; i < 64; ++i) {
-                float z = (i % 2 ? 1.f : -1.f) * (0.2f + sample_1d(2, i, 0, 2));  // both faces
-                Vec3f wi = Vec3f(sample_1d(2, i, 0, 0) - 0.5f, sample_1d(2, i, 0, 1) - 0.5f, z).normalized();
-                float u1 = sample_1d(2, i, 0, 3);
-                Vec2f u2(sample_1d(2, i, 0, 4), sample_1d(2, i, 0, 5));
-                // eval_grad also off the sampler: wo uniform on the whole sphere.
-                float zr = 2.f * sample_1d(2, i, 0, 6) - 1.f, phi = 2.f * kPi * sample_1d(2, i, 0, 7);
-                float rr = std::sqrt(std::max(0.f, 1.f - zr * zr));
-                Vec3f wr(rr * std::cos(phi), rr * std::sin(phi), zr);
-                bsdf->set_spectral(keys[key], c);
-                BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, u1, u2);
-                Spectrum<16> g_rand = bsdf->eval_grad(BSDFContext{}, wi, wr, key);
-                bsdf->set_spectral(keys[key], cp);
-                Spectrum<16> rp = bsdf->eval(BSDFContext{}, wi, wr);
-                bsdf->set_spectral(keys[key], cm);
-                Spectrum<16> rm = bsdf->eval(BSDFContext{}, wi, wr);
-                Spectrum<16> fd_rand = (rp - rm) / step;
-                EXPECT_LT((g_rand - fd_rand).abs().maxCoeff(), tol * (1.f + fd_rand.abs().maxCoeff()))
-                    << cs.name << " " << keys[key] << " random wo";
-                if (!bs.valid()) continue;
-                ++n_valid;
-                bsdf->set_spectral(keys[key], c);
-                Spectrum<16> g_eval = bsdf->eval_grad(BSDFContext{}, wi, bs.wo, key);
-                Spectrum<16> g_weight = bsdf->weight_grad(BSDFContext{}, wi, bs, key);
-                bsdf->set_spectral(keys[key], cp);
-                BSDFSample<16> bp = bsdf->sample(BSDFContext{}, wi, u1, u2);
-                Spectrum<16> ep = bsdf->eval(BSDFContext{}, wi, bs.wo);
-                bsdf->set_spectral(keys[key], cm);
-                BSDFSample<16> bm = bsdf->sample(BSDFContext{}, wi, u1, u2);
-                Spectrum<16> em = bsdf->eval(BSDFContext{}, wi, bs.wo);
-                ASSERT_TRUE(bp.valid() && bm.valid() && bp.lobe == bs.lobe && bm.lobe == bs.lobe) << cs.name;
-                Spectrum<16> fd_eval = (ep - em) / step, fd_weight = (bp.weight - bm.weight) / step;
-                EXPECT_LT((g_eval - fd_eval).abs().maxCoeff(), tol * (1.f + fd_eval.abs().maxCoeff())) << cs.name << " " << keys[key];
-                EXPECT_LT((g_weight - fd_weight).abs().maxCoeff(), tol * (1.f + fd_weight.abs().maxCoeff()))
-                    << cs.name << " " << keys[key] << " lobe " << bs.lobe;
-            }
-            EXPECT_GT(n_valid, 16) << cs.name;  // the sampled branch was actually exercised
+            expect_gradients_match(*bsdf, cs.name, key, keys[key], c, step, cp, cm, tol);
         }
     }
 }
