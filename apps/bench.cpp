@@ -38,8 +38,11 @@ RayPool camera_pool(const Scene& s, int w, int h, size_t n) {
     Camera cam = s.camera.with_resolution(w, h);
     for (size_t i = 0; i < n; ++i) {
         uint32_t px = uint32_t(i % (size_t(w) * h));
-        Ray r = cam.generate_ray(Vec2f(px % w + sample_1d(7, px, uint32_t(i), 0), px / w + sample_1d(7, px, uint32_t(i), 1)));
-        p.o.push_back(r.o); p.d.push_back(r.d); p.tmax.push_back(r.tmax);
+        Ray r = cam.generate_ray(
+            Vec2f(px % w + sample_1d(7, px, uint32_t(i), 0), px / w + sample_1d(7, px, uint32_t(i), 1)));
+        p.o.push_back(r.o);
+        p.d.push_back(r.d);
+        p.tmax.push_back(r.tmax);
     }
     return p;
 }
@@ -53,7 +56,8 @@ RayPool surface_pool(const Scene& s, size_t n, bool shadow) {
     auto pick = [&](uint32_t i, uint32_t k) {
         float u = sample_1d(11, i, k, 0) * acc;
         size_t si = std::min(size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()), cdf.size() - 1);
-        return s.shapes[si].sample_position(Eigen::Vector3f(sample_1d(11, i, k, 1), sample_1d(11, i, k, 2), sample_1d(11, i, k, 3)));
+        return s.shapes[si].sample_position(
+            Eigen::Vector3f(sample_1d(11, i, k, 1), sample_1d(11, i, k, 2), sample_1d(11, i, k, 3)));
     };
     RayPool p;
     for (size_t i = 0; i < n; ++i) {
@@ -66,10 +70,13 @@ RayPool surface_pool(const Scene& s, size_t n, bool shadow) {
             tmax = dir.norm() * (1.f - 1e-4f);
             dir /= std::max(dir.norm(), 1e-12f);
         } else {
-            Vec3f local = sample_cosine_hemisphere(Vec2f(sample_1d(13, uint32_t(i), 0, 0), sample_1d(13, uint32_t(i), 0, 1)));
+            Vec3f local =
+                sample_cosine_hemisphere(Vec2f(sample_1d(13, uint32_t(i), 0, 0), sample_1d(13, uint32_t(i), 0, 1)));
             dir = Frame(sample_1d(13, uint32_t(i), 0, 2) < 0.5f ? a.n : Vec3f(-a.n)).to_world(local);
         }
-        p.o.push_back(offset_ray_origin(a.p, a.n, dir)); p.d.push_back(dir); p.tmax.push_back(tmax);
+        p.o.push_back(offset_ray_origin(a.p, a.n, dir));
+        p.d.push_back(dir);
+        p.tmax.push_back(tmax);
     }
     return p;
 }
@@ -126,7 +133,8 @@ Row bench_scene(const std::string& name, const Scene& scene, const BenchArgs& a,
     for (int rep = 0; rep < kReps; ++rep) {
         render_path<3>(scene, spectra, opt, &row.pt);
         pt_s.push_back(row.pt.seconds);
-        raw_s.push_back(trace_pool(scene, cam, row.pt.camera_rays, false, true) + trace_pool(scene, ext, row.pt.extension_rays, false, false) +
+        raw_s.push_back(trace_pool(scene, cam, row.pt.camera_rays, false, true) +
+                        trace_pool(scene, ext, row.pt.extension_rays, false, false) +
                         trace_pool(scene, shd, row.pt.shadow_rays, true, false));
     }
     std::nth_element(pt_s.begin(), pt_s.begin() + kReps / 2, pt_s.end());
@@ -164,19 +172,25 @@ int run_bench(const BenchArgs& a) {
         scene.build();
         for (SamplerKind s : samplers) rows.push_back(bench_scene("cornell-box+sphere", scene, a, s));
     }
-    std::printf("%-32s %10s %12s %12s %12s %10s\n", "scene (sampler)", "triangles", "rays", "pt Mrays/s", "raw Mrays/s", "pt/raw");
+    std::printf("%-32s %10s %12s %12s %12s %10s\n", "scene (sampler)", "triangles", "rays", "pt Mrays/s", "raw Mrays/s",
+                "pt/raw");
     std::ostringstream js;
     js << "[";
     for (size_t i = 0; i < rows.size(); ++i) {
         const Row& r = rows[i];
         double pt = r.pt.rays() / r.pt.seconds * 1e-6, raw = r.pt.rays() / r.raw_seconds * 1e-6;
-        std::printf("%-32s %10zu %12llu %12.2f %12.2f %9.1f%%\n", r.name.c_str(), r.triangles, (unsigned long long)r.pt.rays(), pt, raw, 100.0 * pt / raw);
-        js << (i ? "," : "") << "{\"scene\":\"" << r.name << "\",\"triangles\":" << r.triangles << ",\"rays\":" << r.pt.rays()
-           << ",\"pt_mrays_per_s\":" << pt << ",\"raw_mrays_per_s\":" << raw << ",\"ratio\":" << pt / raw << "}";
+        std::printf("%-32s %10zu %12llu %12.2f %12.2f %9.1f%%\n", r.name.c_str(), r.triangles,
+                    (unsigned long long)r.pt.rays(), pt, raw, 100.0 * pt / raw);
+        js << (i ? "," : "") << "{\"scene\":\"" << r.name << "\",\"triangles\":" << r.triangles
+           << ",\"rays\":" << r.pt.rays() << ",\"pt_mrays_per_s\":" << pt << ",\"raw_mrays_per_s\":" << raw
+           << ",\"ratio\":" << pt / raw << "}";
     }
     js << "]\n";
-    std::printf("(%d spp at %dx%d; raw = Embree stream calls alone on the same numbers of camera, extension and shadow rays; medians of %d "
-                "alternating runs)\n", a.spp, a.res, a.res, kReps);
+    std::printf(
+        "(%d spp at %dx%d; raw = Embree stream calls alone on the same numbers of camera, extension and shadow rays; "
+        "medians of %d "
+        "alternating runs)\n",
+        a.spp, a.res, a.res, kReps);
     if (!a.out_json.empty()) write_text_atomic(a.out_json, js.str());
     return 0;
 }

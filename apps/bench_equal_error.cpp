@@ -46,13 +46,33 @@ double time_to(const std::vector<Point>& pts, double threshold, bool latent_erro
     return std::numeric_limits<double>::quiet_NaN();
 }
 
+/// Time for each side to reach the latent renderer's error floor × 1.05, in latent and image space.
+void print_equal_error(const std::vector<Point>& lat, const std::vector<Point>& rgb) {
+    double best_latent = 1e300, best_rgb = 1e300;
+    for (const Point& p : lat)
+        best_latent = std::min(best_latent, p.latent_mse), best_rgb = std::min(best_rgb, p.rgb_mse);
+    const double tl = 1.05 * best_latent, tr = 1.05 * best_rgb;
+    const double lat_l = time_to(lat, tl, true, false), rgb_l = time_to(rgb, tl, true, true);
+    const double lat_r = time_to(lat, tr, false, true), rgb_r = time_to(rgb, tr, false, false);
+    std::printf(
+        "\nlatent space, MSE <= %.5f: latent renderer %.4f s, RGB path tracing + encode %.4f s -> latent is %.1fx "
+        "faster\n",
+        tl, lat_l, rgb_l, rgb_l / lat_l);
+    std::printf(
+        "image space,  MSE <= %.6f: latent render + decode %.4f s, RGB path tracing %.4f s -> latent is %.2fx %s\n", tr,
+        lat_r, rgb_r, rgb_r >= lat_r ? rgb_r / lat_r : lat_r / rgb_r, rgb_r >= lat_r ? "faster" : "slower");
+    std::printf(
+        "(NaN: not reached within the spp range; the thresholds are the latent renderer's error floor x 1.05)\n");
+}
+
 }  // namespace
 
 int run_bench_equal_error(const BenchArgs& a) {
     pipeline::FitFolder fit = pipeline::load_fit_folder(a.equal_error);
     const fs::path dir(a.equal_error);
     const int w = fit.latent_width, h = fit.latent_height, W = 8 * w, H = 8 * h;
-    if (!fs::exists(dir / "reference_rgb.exr")) throw std::runtime_error((dir / "reference_rgb.exr").string() + ": missing (the fit needs --encode)");
+    if (!fs::exists(dir / "reference_rgb.exr"))
+        throw std::runtime_error((dir / "reference_rgb.exr").string() + ": missing (the fit needs --encode)");
     const Image target = read_image((dir / "target.exr").string());
     const Image ref_rgb = read_image((dir / "reference_rgb.exr").string());
     if (target.width != w || target.height != h || ref_rgb.width != W || ref_rgb.height != H || ref_rgb.channels != 3)
@@ -61,7 +81,8 @@ int run_bench_equal_error(const BenchArgs& a) {
     const SceneSpectra<3> rgb_spectra = SceneSpectra<3>::from_description(*fit.scene);
     const uint64_t seed = 1;  // the reference used 0x5eed: independent samples
 
-    std::printf("%s: %dx%d latents (%dx%d RGB); errors against the fit's reference\n", a.equal_error.c_str(), w, h, W, H);
+    std::printf("%s: %dx%d latents (%dx%d RGB); errors against the fit's reference\n", a.equal_error.c_str(), w, h, W,
+                H);
     std::printf("%-8s %6s %10s %10s %12s %12s\n", "method", "spp", "render s", "VAE s", "latent MSE", "RGB MSE");
     std::vector<Point> lat, rgb;
     // The warm-up render (thread pool, BVH caches) is not timed.
@@ -90,7 +111,8 @@ int run_bench_equal_error(const BenchArgs& a) {
         p.latent_mse = mse(latent, target.data);
         p.rgb_mse = mse(img, ref_rgb.data);
         lat.push_back(p);
-        std::printf("%-8s %6d %10.4f %10.4f %12.5f %12.6f\n", "latent", spp, p.render_s, p.vae_s, p.latent_mse, p.rgb_mse);
+        std::printf("%-8s %6d %10.4f %10.4f %12.5f %12.6f\n", "latent", spp, p.render_s, p.vae_s, p.latent_mse,
+                    p.rgb_mse);
     }
     for (int spp = 1; spp <= a.max_spp; spp *= 2) {
         RenderOptions o = RenderOptions::from_scene(*fit.scene);
@@ -112,16 +134,7 @@ int run_bench_equal_error(const BenchArgs& a) {
         rgb.push_back(p);
         std::printf("%-8s %6d %10.4f %10.4f %12.5f %12.6f\n", "RGB", spp, p.render_s, p.vae_s, p.latent_mse, p.rgb_mse);
     }
-    double best_latent = 1e300, best_rgb = 1e300;
-    for (const Point& p : lat) best_latent = std::min(best_latent, p.latent_mse), best_rgb = std::min(best_rgb, p.rgb_mse);
-    const double tl = 1.05 * best_latent, tr = 1.05 * best_rgb;
-    const double lat_l = time_to(lat, tl, true, false), rgb_l = time_to(rgb, tl, true, true);
-    const double lat_r = time_to(lat, tr, false, true), rgb_r = time_to(rgb, tr, false, false);
-    std::printf("\nlatent space, MSE <= %.5f: latent renderer %.4f s, RGB path tracing + encode %.4f s -> latent is %.1fx faster\n", tl, lat_l,
-                rgb_l, rgb_l / lat_l);
-    std::printf("image space,  MSE <= %.6f: latent render + decode %.4f s, RGB path tracing %.4f s -> latent is %.2fx %s\n", tr, lat_r, rgb_r,
-                rgb_r >= lat_r ? rgb_r / lat_r : lat_r / rgb_r, rgb_r >= lat_r ? "faster" : "slower");
-    std::printf("(NaN: not reached within the spp range; the thresholds are the latent renderer's error floor x 1.05)\n");
+    print_equal_error(lat, rgb);
     return 0;
 }
 

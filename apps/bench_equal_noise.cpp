@@ -48,7 +48,8 @@ std::string num(double v) {
 std::string default_reference(const std::string& scene) {
     const std::filesystem::path p = std::filesystem::path(scene).parent_path() / "TungstenRender.exr";
     if (!std::filesystem::exists(p))
-        throw std::runtime_error(scene + ": no converged reference beside it (TungstenRender.exr); give one with --reference");
+        throw std::runtime_error(scene +
+                                 ": no converged reference beside it (TungstenRender.exr); give one with --reference");
     return p.string();
 }
 
@@ -62,8 +63,8 @@ int run_bench_equal_noise(const BenchArgs& a) {
     const SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     const RenderStack ref = load_stack({ref_path}, a.res);
     if (ref.width != a.res || ref.height != a.res)
-        throw std::runtime_error(ref_path + ": " + std::to_string(ref.width) + "x" + std::to_string(ref.height) + " after downsampling, not " +
-                                 std::to_string(a.res) + "x" + std::to_string(a.res));
+        throw std::runtime_error(ref_path + ": " + std::to_string(ref.width) + "x" + std::to_string(ref.height) +
+                                 " after downsampling, not " + std::to_string(a.res) + "x" + std::to_string(a.res));
     const std::vector<uint8_t> mask = emitter_mask(scene, a.res, a.res);
     const std::vector<int> ladder = {4, 8, 16, 32, 64, 128, 256};
 
@@ -83,7 +84,8 @@ int run_bench_equal_noise(const BenchArgs& a) {
                 p.seconds += stats.seconds / a.seeds;
                 p.rel_mse += compare_renders(test, ref, mask).rel_mse / a.seeds;
             }
-            std::fprintf(stderr, "equal-noise: %-11s %4d spp  %7.2f s  relMSE %.6f\n", sampler_name(sampler), spp, p.seconds, p.rel_mse);
+            std::fprintf(stderr, "equal-noise: %-11s %4d spp  %7.2f s  relMSE %.6f\n", sampler_name(sampler), spp,
+                         p.seconds, p.rel_mse);
             points.push_back(p);
         }
         ladders.push_back({sampler, points});
@@ -94,8 +96,8 @@ int run_bench_equal_noise(const BenchArgs& a) {
     if (target < 0) throw std::invalid_argument("--target-spp must be one of 4, 8, ..., 256");
 
     const auto independent = reach(ladders[0].second, target), sobol = reach(ladders[1].second, target);
-    std::printf("equal noise: %s at %dx%d, target relMSE %.6f (independent at %d spp); reference %s\n", scene_path.c_str(), a.res, a.res, target,
-                a.target_spp, ref_path.c_str());
+    std::printf("equal noise: %s at %dx%d, target relMSE %.6f (independent at %d spp); reference %s\n",
+                scene_path.c_str(), a.res, a.res, target, a.target_spp, ref_path.c_str());
     std::printf("%-12s %14s %18s\n", "sampler", "spp to target", "seconds to target");
     for (const auto& [name, r] : {std::pair{"independent", independent}, std::pair{"sobol", sobol}}) {
         if (r) std::printf("%-12s %14.1f %18.2f\n", name, r->first, r->second);
@@ -105,13 +107,15 @@ int run_bench_equal_noise(const BenchArgs& a) {
         std::printf("sobol: %.2fx fewer spp, %.2fx faster than independent (render times only, %d seed(s) per point)\n",
                     independent->first / sobol->first, independent->second / sobol->second, a.seeds);
     if (!a.out_json.empty()) {
-        std::string js = "{\"scene\":\"" + scene_path + "\",\"res\":" + std::to_string(a.res) + ",\"target\":" + num(target) +
-                         ",\"target_spp\":" + std::to_string(a.target_spp) + ",\"ladders\":{";
+        std::string js = "{\"scene\":\"" + scene_path + "\",\"res\":" + std::to_string(a.res) +
+                         ",\"target\":" + num(target) + ",\"target_spp\":" + std::to_string(a.target_spp) +
+                         ",\"ladders\":{";
         for (size_t k = 0; k < ladders.size(); ++k) {
             js += std::string(k ? "," : "") + "\"" + sampler_name(ladders[k].first) + "\":[";
             for (size_t i = 0; i < ladders[k].second.size(); ++i) {
                 const LadderPoint& p = ladders[k].second[i];
-                js += std::string(i ? "," : "") + "[" + std::to_string(p.spp) + "," + num(p.seconds) + "," + num(p.rel_mse) + "]";
+                js += std::string(i ? "," : "") + "[" + std::to_string(p.spp) + "," + num(p.seconds) + "," +
+                      num(p.rel_mse) + "]";
             }
             js += "]";
         }

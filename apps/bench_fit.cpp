@@ -24,10 +24,10 @@ int run_bench_fit(const BenchArgs& a) {
     Scene scene = load_scene(path);
     LatentModel model(scene, Parameterisation::Code, 1);
     std::vector<float> d_image(size_t(a.fit_res) * a.fit_res * kLatentChannels, 1e-3f);
-    std::printf("scene %s, %dx%d latents x %d channels, max_depth %d, 2 passes per iteration\n", path.c_str(), a.fit_res, a.fit_res, kLatentChannels,
-                scene.integrator.max_depth);
-    std::printf("%6s %10s %10s %10s %14s | %10s %10s %10s %10s %14s\n", "spp", "forward s", "adjoint s", "total s", "3000 it (min)",
-                "record s", "replay f s", "replay b s", "records MB", "K=8: 3000 it");
+    std::printf("scene %s, %dx%d latents x %d channels, max_depth %d, 2 passes per iteration\n", path.c_str(),
+                a.fit_res, a.fit_res, kLatentChannels, scene.integrator.max_depth);
+    std::printf("%6s %10s %10s %10s %14s | %10s %10s %10s %10s %14s\n", "spp", "forward s", "adjoint s", "total s",
+                "3000 it (min)", "record s", "replay f s", "replay b s", "records MB", "K=8: 3000 it");
     for (int spp : a.fit_spp) {
         RenderOptions o = RenderOptions::from_scene(scene);
         o.width = o.height = a.fit_res;
@@ -60,8 +60,8 @@ int run_bench_fit(const BenchArgs& a) {
         }
         // K = 8: one recording iteration (record + backward replay) per seven replay-only ones.
         const double k8 = (rec + rbwd + 7 * (rfwd + rbwd)) / 8;
-        std::printf("%6d %10.3f %10.3f %10.3f %14.1f | %10.3f %10.3f %10.3f %10.0f %14.1f\n", spp, fwd, adj, fwd + adj, 3000 * (fwd + adj) / 60,
-                    rec, rfwd, rbwd, mb, 3000 * k8 / 60);
+        std::printf("%6d %10.3f %10.3f %10.3f %14.1f | %10.3f %10.3f %10.3f %10.0f %14.1f\n", spp, fwd, adj, fwd + adj,
+                    3000 * (fwd + adj) / 60, rec, rfwd, rbwd, mb, 3000 * k8 / 60);
     }
     return 0;
 }

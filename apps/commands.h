@@ -18,26 +18,26 @@ class Scene;
 
 namespace lpt::app {
 
-using pipeline::VaeSource;
 using pipeline::default_lpips_dir;
 using pipeline::default_vae_dir;
 using pipeline::shared_dir;
+using pipeline::VaeSource;
 
 struct RenderArgs {
     std::string scene;
     std::string out = "render.exr";
-    int spp = 0;                  ///< 0 = the scene's
-    std::string res;              ///< "WxH", empty = the scene's
+    int spp = 0;      ///< 0 = the scene's
+    std::string res;  ///< "WxH", empty = the scene's
     uint64_t seed = 0;
-    int max_depth = -2;           ///< -2 = the scene's
+    int max_depth = -2;  ///< -2 = the scene's
     std::string strategy = "mis";
     bool aov = false;
-    std::string aov_res;          ///< "WxH", empty = the image's
+    std::string aov_res;  ///< "WxH", empty = the image's
     float exposure = 0.f;
     std::map<std::string, std::string> defines;
     bool quiet = false;
-    std::string edit;             ///< edits.json, when `scene` is a fit folder
-    bool reference = false;       ///< also path trace + encode each edited frame, write metrics.csv
+    std::string edit;        ///< edits.json, when `scene` is a fit folder
+    bool reference = false;  ///< also path trace + encode each edited frame, write metrics.csv
     int ref_spp = 256;
     std::string reference_cache;  ///< folder keeping path-traced reference frames for reuse
 };
@@ -45,21 +45,21 @@ int run_render(const RenderArgs& args);
 int run_render_edit(const RenderArgs& args);
 
 struct BenchArgs {
-    std::string scene;            ///< empty = the bundled Cornell box
+    std::string scene;  ///< empty = the bundled Cornell box
     int spp = 16;
     int res = 256;
     int sphere_triangles = 100000;
-    std::string out_json;         ///< optional machine-readable results
-    bool fit = false;             ///< time fit iterations (forward / adjoint) instead of rays/s
-    std::string fit_scene;        ///< default: ../shared/scenes/cbox/cbox_specular.xml, else ours
+    std::string out_json;   ///< optional machine-readable results
+    bool fit = false;       ///< time fit iterations (forward / adjoint) instead of rays/s
+    std::string fit_scene;  ///< default: ../shared/scenes/cbox/cbox_specular.xml, else ours
     int fit_res = 128;
     std::vector<int> fit_spp{16, 64, 256};
-    std::string equal_error;      ///< fit folder: latent vs RGB time to equal error
-    int max_spp = 1024;           ///< --equal-error: highest RGB spp (latent: a quarter of it)
-    bool equal_noise = false;     ///< spp and seconds to a noise target, Sobol vs independent
-    std::string reference;        ///< --equal-noise: converged reference (default: Tungsten's, cornell box)
-    int target_spp = 64;          ///< --equal-noise: target = the independent sampler's noise at this spp
-    int seeds = 2;                ///< --equal-noise: renders per ladder point
+    std::string equal_error;   ///< fit folder: latent vs RGB time to equal error
+    int max_spp = 1024;        ///< --equal-error: highest RGB spp (latent: a quarter of it)
+    bool equal_noise = false;  ///< spp and seconds to a noise target, Sobol vs independent
+    std::string reference;     ///< --equal-noise: converged reference (default: Tungsten's, cornell box)
+    int target_spp = 64;       ///< --equal-noise: target = the independent sampler's noise at this spp
+    int seeds = 2;             ///< --equal-noise: renders per ladder point
 };
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);
@@ -90,7 +90,10 @@ int run_encode(const VaeArgs& args);
 int run_decode(const VaeArgs& args);
 int run_viz(const VaeArgs& args);
 
-struct MetricsArgs { std::string a, b, vae_dir; bool json = false; };
+struct MetricsArgs {
+    std::string a, b, vae_dir;
+    bool json = false;
+};
 int run_metrics(const MetricsArgs&);
 
 /// `latentpt compare`: bias of renders against an independent reference beyond their noise.
@@ -99,12 +102,12 @@ struct CompareArgs {
     std::string scene;                   ///< optional: masks directly seen emitters
     std::map<std::string, std::string> defines;
     int block = 32;
-    double sigma = 3.0;                  ///< a block beyond this many σ of its noise is flagged
-    double mean_tolerance = 0.005;       ///< verdict: channel means within this relative difference
-    double ratio_range = 0.1;            ///< ratio map saturates at 1 ± this
+    double sigma = 3.0;             ///< a block beyond this many σ of its noise is flagged
+    double mean_tolerance = 0.005;  ///< verdict: channel means within this relative difference
+    double ratio_range = 0.1;       ///< ratio map saturates at 1 ± this
     float exposure = 0.f;
     std::string out_dir;
-    bool strict = false;                 ///< exit 3 when the verdict fails
+    bool strict = false;  ///< exit 3 when the verdict fails
 };
 int run_compare(const CompareArgs& a);
 

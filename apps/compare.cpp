@@ -65,7 +65,12 @@ nlohmann::json to_json(const ImageComparison& c, const CompareArgs& a) {
     j["blocks_flagged"] = c.flagged;
     nlohmann::json blocks = nlohmann::json::array();
     for (const auto& b : c.blocks)
-        blocks.push_back({{"x0", b.x0}, {"y0", b.y0}, {"pixels", b.pixels}, {"ratio", b.ratio}, {"sigma", b.sigma}, {"z", b.z},
+        blocks.push_back({{"x0", b.x0},
+                          {"y0", b.y0},
+                          {"pixels", b.pixels},
+                          {"ratio", b.ratio},
+                          {"sigma", b.sigma},
+                          {"z", b.z},
                           {"flagged", b.flagged}});
     j["blocks"] = blocks;
     return j;
@@ -83,14 +88,16 @@ int run_compare(const CompareArgs& a) {
     if (!a.scene.empty()) mask = emitter_mask(load_scene(a.scene, a.defines), test.width, test.height);
     const ImageComparison c = compare_renders(test, ref, mask, a.block, a.sigma);
 
-    std::string report = format_comparison(c, a.test.front() + (a.test.size() > 1 ? " (+" + std::to_string(a.test.size() - 1) + ")" : ""),
-                                           a.ref.front() + (a.ref.size() > 1 ? " (+" + std::to_string(a.ref.size() - 1) + ")" : ""));
+    std::string report = format_comparison(
+        c, a.test.front() + (a.test.size() > 1 ? " (+" + std::to_string(a.test.size() - 1) + ")" : ""),
+        a.ref.front() + (a.ref.size() > 1 ? " (+" + std::to_string(a.ref.size() - 1) + ")" : ""));
     bool means_ok = true;
     for (double r : c.mean_ratio) means_ok = means_ok && std::abs(r - 1.0) <= a.mean_tolerance;
     const bool blocks_ok = c.flagged == 0 && (c.test_noise_known || c.ref_noise_known);
     report += std::string("verdict: ") + (means_ok && blocks_ok ? "PASS" : "FAIL") + " (means within " +
-              std::to_string(a.mean_tolerance * 100.0).substr(0, 4) + " %: " + (means_ok ? "yes" : "no") + "; no block beyond " +
-              std::to_string(a.sigma).substr(0, 3) + " sigma: " + (blocks_ok ? "yes" : "no") + ")\n";
+              std::to_string(a.mean_tolerance * 100.0).substr(0, 4) + " %: " + (means_ok ? "yes" : "no") +
+              "; no block beyond " + std::to_string(a.sigma).substr(0, 3) + " sigma: " + (blocks_ok ? "yes" : "no") +
+              ")\n";
     std::cout << report << std::flush;
 
     if (!a.out_dir.empty()) {
@@ -101,10 +108,12 @@ int run_compare(const CompareArgs& a) {
         const std::vector<float> map = ratio_map(c, test.width, test.height, a.ratio_range);
         write_png_display((dir / "ratio_map.png").string(), Image{test.width, test.height, 3, map, {"R", "G", "B"}});
         write_png_display((dir / "side_by_side.png").string(),
-                          side_by_side({preview(mean_of(test), a.exposure), preview(mean_of(ref), a.exposure), map}, test.width, test.height));
-        std::cerr << "wrote " << (dir / "comparison.txt").string() << ", comparison.json, ratio_map.png, side_by_side.png "
-                  << "(test | reference | block ratio: red = test brighter, blue = darker, saturated at ±" << a.ratio_range * 100
-                  << " %, flagged blocks outlined)\n";
+                          side_by_side({preview(mean_of(test), a.exposure), preview(mean_of(ref), a.exposure), map},
+                                       test.width, test.height));
+        std::cerr << "wrote " << (dir / "comparison.txt").string()
+                  << ", comparison.json, ratio_map.png, side_by_side.png "
+                  << "(test | reference | block ratio: red = test brighter, blue = darker, saturated at ±"
+                  << a.ratio_range * 100 << " %, flagged blocks outlined)\n";
     }
     return a.strict && !(means_ok && blocks_ok) ? 3 : 0;
 }

@@ -12,26 +12,37 @@ namespace {
 
 /// The autoencoder: native TAESD3 weights, or any VAE exported to TorchScript (tools/export_vae.py).
 void add_vae_options(CLI::App* sc, VaeSource& vs) {
-    sc->add_option("--vae-dir", vs.dir, "TAESD3 weights folder, <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
-    sc->add_option("--vae-encoder", vs.encoder, "TorchScript encoder module (with --vae-decoder, --vae-config; e.g. the SD3.5 VAE)")->check(CLI::ExistingFile);
+    sc->add_option("--vae-dir", vs.dir,
+                   "TAESD3 weights folder, <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
+    sc->add_option("--vae-encoder", vs.encoder,
+                   "TorchScript encoder module (with --vae-decoder, --vae-config; e.g. the SD3.5 VAE)")
+        ->check(CLI::ExistingFile);
     sc->add_option("--vae-decoder", vs.decoder, "TorchScript decoder module")->check(CLI::ExistingFile);
-    sc->add_option("--vae-config", vs.config, "vae.json of the TorchScript VAE: channels, downsample, scale, shift, image_range, latent")->check(CLI::ExistingFile);
+    sc->add_option("--vae-config", vs.config,
+                   "vae.json of the TorchScript VAE: channels, downsample, scale, shift, image_range, latent")
+        ->check(CLI::ExistingFile);
 }
 
 /// Stage-2 options: `--refiner-<name>` on fit, `--<name>` on refine.
 void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string& pre) {
     sc->add_option("--" + pre + "iterations", ra.train.iterations, "refiner training steps")->capture_default_str();
-    sc->add_option("--" + pre + "expansion", ra.net.expansion, "refiner width = expansion x 16 channels")->capture_default_str();
-    sc->add_option("--" + pre + "crop", ra.train.crop, "latent crop side per refiner step (0 = the whole view)")->capture_default_str();
-    sc->add_option("--" + pre + "lpips-crop", ra.train.lpips_crop, "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")->capture_default_str();
+    sc->add_option("--" + pre + "expansion", ra.net.expansion, "refiner width = expansion x 16 channels")
+        ->capture_default_str();
+    sc->add_option("--" + pre + "crop", ra.train.crop, "latent crop side per refiner step (0 = the whole view)")
+        ->capture_default_str();
+    sc->add_option("--" + pre + "lpips-crop", ra.train.lpips_crop,
+                   "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")
+        ->capture_default_str();
     sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")->capture_default_str();
-    sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")->capture_default_str();
+    sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")
+        ->capture_default_str();
     sc->add_option("--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE")->capture_default_str();
     sc->add_option("--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM")->capture_default_str();
     sc->add_option("--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops")->capture_default_str();
     sc->add_option("--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)")->capture_default_str();
     sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")->capture_default_str();
-    sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")->capture_default_str();
+    sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")
+        ->capture_default_str();
     sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
 }
 
@@ -48,114 +59,172 @@ struct Cli {
     VaeArgs v;
     MetricsArgs m;
     CompareArgs cmp;
-    CLI::App *render = nullptr, *bench = nullptr, *fit = nullptr, *refine = nullptr, *encode = nullptr, *decode = nullptr,
-             *viz = nullptr, *metrics = nullptr, *compare = nullptr;
+    CLI::App *render = nullptr, *bench = nullptr, *fit = nullptr, *refine = nullptr, *encode = nullptr,
+             *decode = nullptr, *viz = nullptr, *metrics = nullptr, *compare = nullptr;
 
     void add_render(CLI::App& app) {
-    std::vector<std::string> defines;
-            render = app.add_subcommand("render", "path trace a scene (.json) to a float EXR plus an sRGB PNG preview");
-        render->add_option("scene", r.scene, "scene file (.json or Mitsuba 3 .xml), or a fit folder with --edit")->required()->check(CLI::ExistingPath);
-        render->add_option("--edit", r.edit, "edits.json: render the fitted latent scene edited (camera, shapes), frame by frame, and decode")
+        std::vector<std::string> defines;
+        render = app.add_subcommand("render", "path trace a scene (.json) to a float EXR plus an sRGB PNG preview");
+        render->add_option("scene", r.scene, "scene file (.json or Mitsuba 3 .xml), or a fit folder with --edit")
+            ->required()
+            ->check(CLI::ExistingPath);
+        render
+            ->add_option(
+                "--edit", r.edit,
+                "edits.json: render the fitted latent scene edited (camera, shapes), frame by frame, and decode")
             ->check(CLI::ExistingFile);
-        render->add_flag("--reference", r.reference, "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv");
+        render->add_flag("--reference", r.reference,
+                         "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv");
         render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")->capture_default_str();
-        render->add_option("--reference-cache", r.reference_cache, "with --reference: keep path-traced frames in this folder and reuse them "
-                                                                    "(keyed by edits file name, size, spp, tone and frame)");
+        render->add_option("--reference-cache", r.reference_cache,
+                           "with --reference: keep path-traced frames in this folder and reuse them "
+                           "(keyed by edits file name, size, spp, tone and frame)");
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
         render->add_option("--spp", r.spp, "samples per pixel (default: the scene's)");
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");
-        render->add_option("--seed", r.seed, "random seed: same seed, same image, at any thread count")->capture_default_str();
-        render->add_option("--max-depth", r.max_depth, "longest path in segments, -1 = unbounded (default: the scene's)");
+        render->add_option("--seed", r.seed, "random seed: same seed, same image, at any thread count")
+            ->capture_default_str();
+        render->add_option("--max-depth", r.max_depth,
+                           "longest path in segments, -1 = unbounded (default: the scene's)");
         render->add_option("--strategy", r.strategy, "light estimator: mis (NEE + BSDF sampling), nee, bsdf")
-            ->check(CLI::IsMember({"mis", "nee", "bsdf"}))->capture_default_str();
+            ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
+            ->capture_default_str();
         render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr");
-        render->add_option("--aov-res", r.aov_res, "AOV resolution WxH (default: the image's; e.g. image/8 for latents)");
+        render->add_option("--aov-res", r.aov_res,
+                           "AOV resolution WxH (default: the image's; e.g. image/8 for latents)");
         render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")->capture_default_str();
         render->add_option("-D,--define", defines, "override a scene value, e.g. -D integrator.max_depth=4");
         render->add_flag("-q,--quiet", r.quiet, "no progress line");
-
     }
 
     void add_bench(CLI::App& app) {
-        bench = app.add_subcommand("bench", "rays/s of the path tracer next to raw Embree throughput on the same ray counts");
+        bench = app.add_subcommand("bench",
+                                   "rays/s of the path tracer next to raw Embree throughput on the same ray counts");
         bench->add_option("--scene", b.scene, "scene (default: scenes/cornell-box/scene.json)");
         bench->add_option("--spp", b.spp, "samples per pixel")->capture_default_str();
         bench->add_option("--res", b.res, "square resolution")->capture_default_str();
-        bench->add_option("--sphere-triangles", b.sphere_triangles, "triangles of the sphere added for the heavy-scene run")->capture_default_str();
+        bench
+            ->add_option("--sphere-triangles", b.sphere_triangles,
+                         "triangles of the sphere added for the heavy-scene run")
+            ->capture_default_str();
         bench->add_option("--json", b.out_json, "also write the results as JSON");
         bench->add_flag("--fit", b.fit, "time fit iterations (forward and adjoint) at latent resolution instead");
-        bench->add_option("--fit-scene", b.fit_scene, "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)");
+        bench->add_option("--fit-scene", b.fit_scene,
+                          "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)");
         bench->add_option("--fit-res", b.fit_res, "latent resolution for --fit")->capture_default_str();
         bench->add_option("--fit-spp", b.fit_spp, "samples per pixel per iteration for --fit")->capture_default_str();
-        bench->add_option("--equal-error", b.equal_error, "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
-                                                          "the same latent error, and latent + decode vs RGB for the same image error")
+        bench
+            ->add_option("--equal-error", b.equal_error,
+                         "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
+                         "the same latent error, and latent + decode vs RGB for the same image error")
             ->check(CLI::ExistingDirectory);
-        bench->add_option("--max-spp", b.max_spp, "with --equal-error: highest RGB spp (latent side: a quarter)")->capture_default_str();
-        bench->add_flag("--equal-noise", b.equal_noise, "spp and render seconds to one noise level, Sobol vs independent sampler, against a converged "
-                                                        "reference (default scene: ../shared cornell-box scene_v3.xml; docs/sampling.md)");
-        bench->add_option("--reference", b.reference, "with --equal-noise: converged reference EXR (default: TungstenRender.exr beside the scene)")
-            ->check(CLI::ExistingFile);
-        bench->add_option("--target-spp", b.target_spp, "with --equal-noise: target = the independent sampler's noise at this spp (4 ... 256)")
+        bench->add_option("--max-spp", b.max_spp, "with --equal-error: highest RGB spp (latent side: a quarter)")
             ->capture_default_str();
-        bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")->capture_default_str()->check(CLI::PositiveNumber);
-
+        bench->add_flag("--equal-noise", b.equal_noise,
+                        "spp and render seconds to one noise level, Sobol vs independent sampler, against a converged "
+                        "reference (default scene: ../shared cornell-box scene_v3.xml; docs/sampling.md)");
+        bench
+            ->add_option("--reference", b.reference,
+                         "with --equal-noise: converged reference EXR (default: TungstenRender.exr beside the scene)")
+            ->check(CLI::ExistingFile);
+        bench
+            ->add_option("--target-spp", b.target_spp,
+                         "with --equal-noise: target = the independent sampler's noise at this spp (4 ... 256)")
+            ->capture_default_str();
+        bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")
+            ->capture_default_str()
+            ->check(CLI::PositiveNumber);
     }
 
     void add_fit(CLI::App& app) {
         fit = app.add_subcommand("fit", "fit per-shape latent parameters to a target latent map (stage 1)");
-        fit->add_option("scene", f.job.scene, "scene file (.json or Mitsuba 3 .xml)")->required()->check(CLI::ExistingFile);
-        fit->add_option("--target", f.job.target, "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
-                                              "without it, a synthetic target rendered from random parameters")->check(CLI::ExistingFile);
+        fit->add_option("scene", f.job.scene, "scene file (.json or Mitsuba 3 .xml)")
+            ->required()
+            ->check(CLI::ExistingFile);
+        fit->add_option("--target", f.job.target,
+                        "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
+                        "without it, a synthetic target rendered from random parameters")
+            ->check(CLI::ExistingFile);
         fit->add_option("-o,--out", f.job.out, "output folder")->capture_default_str();
-        fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")->capture_default_str();
-        fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")->capture_default_str();
+        fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")
+            ->capture_default_str();
+        fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
+            ->capture_default_str();
         fit->add_option("--iterations", f.job.options.iterations, "optimiser steps")->capture_default_str();
         fit->add_option("--spp", f.job.options.spp, "samples per pixel per iteration")->capture_default_str();
         fit->add_option("--final-spp", f.job.final_spp, "samples per pixel of the final render")->capture_default_str();
-        fit->add_option("--seed", f.job.options.seed, "seed of the initial parameters and of every iteration's paths")->capture_default_str();
-        fit->add_option("--lr", f.job.options.lr, "Adam learning rate (cosine annealing with warm restarts)")->capture_default_str();
-        fit->add_option("--lr-min", f.job.options.lr_min, "minimum learning rate of the schedule")->capture_default_str();
+        fit->add_option("--seed", f.job.options.seed, "seed of the initial parameters and of every iteration's paths")
+            ->capture_default_str();
+        fit->add_option("--lr", f.job.options.lr, "Adam learning rate (cosine annealing with warm restarts)")
+            ->capture_default_str();
+        fit->add_option("--lr-min", f.job.options.lr_min, "minimum learning rate of the schedule")
+            ->capture_default_str();
         fit->add_option("--lr-period", f.job.options.lr_period, "iterations per restart period")->capture_default_str();
-        fit->add_option("--patience", f.job.options.patience, "early stopping: iterations without improvement of the smoothed loss; 0 = off")->capture_default_str();
-        fit->add_option("--min-delta", f.job.options.min_delta, "early stopping: smallest improvement that counts")->capture_default_str();
-        fit->add_option("--tone", fit_tone, "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
-            ->check(CLI::IsMember({"clip", "reinhard", "logit"}))->capture_default_str();
-        fit->add_option("--param", f.job.param, "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
-            ->check(CLI::IsMember({"code", "paper", "classic"}))->capture_default_str();
-        fit->add_option("--gate", f.job.gate, "Ic gate: shadowed (1 - V) or visible (V)")->check(CLI::IsMember({"shadowed", "visible"}))->capture_default_str();
-        fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")->capture_default_str();
-        fit->add_option("--checkpoint-every", f.job.options.checkpoint_every, "iterations between checkpoints; 0 = only at the end")->capture_default_str();
+        fit->add_option("--patience", f.job.options.patience,
+                        "early stopping: iterations without improvement of the smoothed loss; 0 = off")
+            ->capture_default_str();
+        fit->add_option("--min-delta", f.job.options.min_delta, "early stopping: smallest improvement that counts")
+            ->capture_default_str();
+        fit->add_option("--tone", fit_tone,
+                        "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
+            ->check(CLI::IsMember({"clip", "reinhard", "logit"}))
+            ->capture_default_str();
+        fit->add_option(
+               "--param", f.job.param,
+               "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
+            ->check(CLI::IsMember({"code", "paper", "classic"}))
+            ->capture_default_str();
+        fit->add_option("--gate", f.job.gate, "Ic gate: shadowed (1 - V) or visible (V)")
+            ->check(CLI::IsMember({"shadowed", "visible"}))
+            ->capture_default_str();
+        fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")
+            ->capture_default_str();
+        fit->add_option("--checkpoint-every", f.job.options.checkpoint_every,
+                        "iterations between checkpoints; 0 = only at the end")
+            ->capture_default_str();
         fit->add_option("--reuse-paths", f.job.options.reuse_paths,
-                        "K: trace and store one frame of paths every K iterations and replay them in between (no rays; ~56 bytes per path event, "
-                        "~140 MB at 128x128 latents x 16 spp); 0: fresh paths every iteration, re-traced for the gradient (least memory). "
+                        "K: trace and store one frame of paths every K iterations and replay them in between (no rays; "
+                        "~56 bytes per path event, "
+                        "~140 MB at 128x128 latents x 16 spp); 0: fresh paths every iteration, re-traced for the "
+                        "gradient (least memory). "
                         "Equal final loss for K = 0, 1, 8, 32 on the CBox (docs/fitting.md)")
             ->capture_default_str()
             ->check(CLI::NonNegativeNumber);
         fit->add_flag("--resume", f.job.resume, "continue from <out>/checkpoint");
-        fit->add_flag("--encode", f.job.encode, "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
-        fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")->capture_default_str();
-        fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")->capture_default_str();
-        fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")->check(CLI::IsMember({"clip", "reinhard"}))->capture_default_str();
+        fit->add_flag("--encode", f.job.encode,
+                      "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
+        fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")
+            ->capture_default_str();
+        fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")
+            ->capture_default_str();
+        fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")
+            ->check(CLI::IsMember({"clip", "reinhard"}))
+            ->capture_default_str();
         add_vae_options(fit, f.job.vae);
         fit->add_option("-D,--define", fit_defines, "override a scene value (as for render)");
         fit->add_flag("!--no-refiner", f.job.refiner, "stop after stage 1 (no refiner training)");
         fit->add_flag("-q,--quiet", f.quiet, "no progress line");
-    
+
         add_refine_options(fit, f.job.refine, "refiner-");
     }
 
     void add_refine(CLI::App& app) {
-        refine = app.add_subcommand("refine", "train the per-scene refiner on a fit folder (stage 2; fit runs it unless --no-refiner)");
-        refine->add_option("fitdir", rf.job.fitdir, "folder written by latentpt fit")->required()->check(CLI::ExistingDirectory);
+        refine = app.add_subcommand(
+            "refine", "train the per-scene refiner on a fit folder (stage 2; fit runs it unless --no-refiner)");
+        refine->add_option("fitdir", rf.job.fitdir, "folder written by latentpt fit")
+            ->required()
+            ->check(CLI::ExistingDirectory);
         add_refine_options(refine, rf.job, "");
-        refine->add_option("--seed", rf.job.train.seed, "seed of the initial weights, crops and dropout")->capture_default_str();
+        refine->add_option("--seed", rf.job.train.seed, "seed of the initial weights, crops and dropout")
+            ->capture_default_str();
         refine->add_flag("--resume", rf.job.resume, "continue from <fitdir>/refiner_checkpoint.pt");
         refine->add_flag("-q,--quiet", rf.quiet, "no progress line");
-    
     }
 
     void add_vae_commands(CLI::App& app) {
-        encode = app.add_subcommand("encode", "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR (TAESD3 or a TorchScript VAE)");
+        encode = app.add_subcommand("encode",
+                                    "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR "
+                                    "(TAESD3 or a TorchScript VAE)");
         decode = app.add_subcommand("decode", "latent EXR -> RGB image (PNG, or EXR unclamped)");
         viz = app.add_subcommand("viz", "latent EXR -> PNG of its channels (green positive, red negative)");
         for (auto* sc : {encode, decode, viz}) {
@@ -164,37 +233,56 @@ struct Cli {
             sc->add_flag("-q,--quiet", v.quiet, "no messages");
         }
         for (auto* sc : {encode, decode}) add_vae_options(sc, v.vae);
-    
     }
 
     void add_metrics(CLI::App& app) {
-        metrics = app.add_subcommand("metrics", "MSE, PSNR, SSIM and LPIPS between two images (PNG display values or linear EXR), "
-                                                      "or MSE, PSNR and SSIM between two 16-channel latent EXRs");
+        metrics = app.add_subcommand("metrics",
+                                     "MSE, PSNR, SSIM and LPIPS between two images (PNG display values or linear EXR), "
+                                     "or MSE, PSNR and SSIM between two 16-channel latent EXRs");
         metrics->add_option("a", m.a, "first image or latent EXR")->required()->check(CLI::ExistingFile);
-        metrics->add_option("b", m.b, "second image or latent EXR, same size and kind")->required()->check(CLI::ExistingFile);
+        metrics->add_option("b", m.b, "second image or latent EXR, same size and kind")
+            ->required()
+            ->check(CLI::ExistingFile);
         metrics->add_option("--lpips-dir", m.vae_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
         metrics->add_flag("--json", m.json, "print one JSON object instead of text");
-    
     }
 
     void add_compare(CLI::App& app) {
-        compare = app.add_subcommand("compare", "bias of a render against an independent reference, beyond both renders' noise: "
-                                                      "channel mean ratios, block ratios with per-block noise, emitter-masked relMSE, "
-                                                      "pictures (docs/validation.md)");
-        compare->add_option("--test", cmp.test, "render(s) under test: give >= 2 with independent seeds to estimate their noise")
-            ->required()->check(CLI::ExistingFile);
-        compare->add_option("--ref", cmp.ref, "reference render(s), same size or an integer multiple (box-averaged down)")
-            ->required()->check(CLI::ExistingFile);
-        compare->add_option("--scene", cmp.scene, "scene of the renders: pixels that see an emitter directly are left out")->check(CLI::ExistingFile);
+        compare = app.add_subcommand("compare",
+                                     "bias of a render against an independent reference, beyond both renders' noise: "
+                                     "channel mean ratios, block ratios with per-block noise, emitter-masked relMSE, "
+                                     "pictures (docs/validation.md)");
+        compare
+            ->add_option("--test", cmp.test,
+                         "render(s) under test: give >= 2 with independent seeds to estimate their noise")
+            ->required()
+            ->check(CLI::ExistingFile);
+        compare
+            ->add_option("--ref", cmp.ref, "reference render(s), same size or an integer multiple (box-averaged down)")
+            ->required()
+            ->check(CLI::ExistingFile);
+        compare
+            ->add_option("--scene", cmp.scene, "scene of the renders: pixels that see an emitter directly are left out")
+            ->check(CLI::ExistingFile);
         compare->add_option("-D,--define", cmp_defines, "scene override, as for render");
-        compare->add_option("--block", cmp.block, "block side in pixels")->capture_default_str()->check(CLI::PositiveNumber);
-        compare->add_option("--sigma", cmp.sigma, "flag blocks whose ratio is this many standard deviations of its noise from 1")->capture_default_str();
-        compare->add_option("--mean-tolerance", cmp.mean_tolerance, "verdict: channel means within this relative difference")->capture_default_str();
-        compare->add_option("--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this")->capture_default_str();
-        compare->add_option("--exposure", cmp.exposure, "exposure of the side-by-side previews in stops")->capture_default_str();
-        compare->add_option("-o,--out-dir", cmp.out_dir, "write comparison.txt/.json, ratio_map.png, side_by_side.png here");
+        compare->add_option("--block", cmp.block, "block side in pixels")
+            ->capture_default_str()
+            ->check(CLI::PositiveNumber);
+        compare
+            ->add_option("--sigma", cmp.sigma,
+                         "flag blocks whose ratio is this many standard deviations of its noise from 1")
+            ->capture_default_str();
+        compare
+            ->add_option("--mean-tolerance", cmp.mean_tolerance,
+                         "verdict: channel means within this relative difference")
+            ->capture_default_str();
+        compare->add_option("--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this")
+            ->capture_default_str();
+        compare->add_option("--exposure", cmp.exposure, "exposure of the side-by-side previews in stops")
+            ->capture_default_str();
+        compare->add_option("-o,--out-dir", cmp.out_dir,
+                            "write comparison.txt/.json, ratio_map.png, side_by_side.png here");
         compare->add_flag("--strict", cmp.strict, "exit with code 3 when the verdict is FAIL");
-    
     }
 
     /// Runs the chosen subcommand (after parsing).
@@ -204,7 +292,10 @@ struct Cli {
             return r.edit.empty() ? run_render(r) : run_render_edit(r);
         }
         if (*bench)
-            return !b.equal_error.empty() ? run_bench_equal_error(b) : b.equal_noise ? run_bench_equal_noise(b) : b.fit ? run_bench_fit(b) : run_bench(b);
+            return !b.equal_error.empty() ? run_bench_equal_error(b)
+                   : b.equal_noise        ? run_bench_equal_noise(b)
+                   : b.fit                ? run_bench_fit(b)
+                                          : run_bench(b);
         if (*encode) return run_encode(v);
         if (*decode) return run_decode(v);
         if (*viz) return run_viz(v);
@@ -243,8 +334,9 @@ int main(int argc, char** argv) {
     CLI::App app{"latentpt: a differentiable path tracer that renders into the latent space of an image autoencoder"};
     app.require_subcommand(1);
     app.add_option("--threads", cli.threads, "worker threads (default: all cores)");
-    app.add_option("--sampler", cli.sampler, "random numbers of every render: sobol (Owen-scrambled, low discrepancy) or independent "
-                                             "(default: the scene's; docs/sampling.md)")
+    app.add_option("--sampler", cli.sampler,
+                   "random numbers of every render: sobol (Owen-scrambled, low discrepancy) or independent "
+                   "(default: the scene's; docs/sampling.md)")
         ->check(CLI::IsMember({"sobol", "independent"}));
     cli.add_render(app);
     cli.add_bench(app);
@@ -255,9 +347,11 @@ int main(int argc, char** argv) {
     cli.add_compare(app);
     CLI11_PARSE(app, argc, argv);
     std::unique_ptr<tbb::global_control> limit;
-    if (cli.threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, cli.threads);
+    if (cli.threads > 0)
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, cli.threads);
     lpt::SamplerKind sampler_kind;
-    if (lpt::parse_sampler(cli.sampler, sampler_kind)) lpt::set_sampler_override(sampler_kind);  // empty: the scenes decide
+    if (lpt::parse_sampler(cli.sampler, sampler_kind))
+        lpt::set_sampler_override(sampler_kind);  // empty: the scenes decide
     try {
         return cli.run();
     } catch (const std::exception& e) {

@@ -35,7 +35,7 @@ constexpr int kLatentChannels = 16;
 struct Loaded {
     int width = 0, height = 0, channels = 0;  ///< channels of `data` (3 for RGB)
     bool latent = false;
-    std::string kind;                         ///< how the values were interpreted
+    std::string kind;  ///< how the values were interpreted
     std::vector<float> data;
 };
 
@@ -58,7 +58,8 @@ Loaded load(const std::string& path) {
         return l;
     }
     if (img.channels != 3 && img.channels != 4)
-        throw std::runtime_error(path + ": " + std::to_string(img.channels) + " channels; metrics compares RGB(A) images (3 or 4 channels) or " +
+        throw std::runtime_error(path + ": " + std::to_string(img.channels) +
+                                 " channels; metrics compares RGB(A) images (3 or 4 channels) or " +
                                  std::to_string(kLatentChannels) + "-channel latent EXRs");
     const bool linear = is_float_format(path);
     l.channels = 3;
@@ -100,10 +101,12 @@ std::string json_number(const std::optional<double>& v) {
 int run_metrics(const MetricsArgs& args) {
     Loaded a = load(args.a), b = load(args.b);
     if (a.latent != b.latent || a.channels != b.channels)
-        throw std::runtime_error("metrics needs the same kind of data in both files: " + args.a + " is " + a.kind + ", " + args.b + " is " + b.kind);
+        throw std::runtime_error("metrics needs the same kind of data in both files: " + args.a + " is " + a.kind +
+                                 ", " + args.b + " is " + b.kind);
     if (a.width != b.width || a.height != b.height)
-        throw std::runtime_error("metrics needs images of the same size: " + args.a + " is " + std::to_string(a.width) + "x" +
-                                 std::to_string(a.height) + ", " + args.b + " is " + std::to_string(b.width) + "x" + std::to_string(b.height));
+        throw std::runtime_error("metrics needs images of the same size: " + args.a + " is " + std::to_string(a.width) +
+                                 "x" + std::to_string(a.height) + ", " + args.b + " is " + std::to_string(b.width) +
+                                 "x" + std::to_string(b.height));
 
     const double range = a.latent ? kLatentDataRange : kImageDataRange;
     double se = 0;
@@ -116,12 +119,14 @@ int run_metrics(const MetricsArgs& args) {
 
     std::optional<double> ssim_v, lpips_v;
     std::string ssim_note, lpips_note;
-    if (a.width >= kSsimWindow && a.height >= kSsimWindow) ssim_v = ssim(a.data.data(), b.data.data(), a.width, a.height, a.channels, range);
+    if (a.width >= kSsimWindow && a.height >= kSsimWindow)
+        ssim_v = ssim(a.data.data(), b.data.data(), a.width, a.height, a.channels, range);
     else ssim_note = "n/a (image smaller than the 11x11 window)";
 
     if (a.latent) lpips_note = "n/a (latents; LPIPS is an RGB metric)";
     else if (a.width < Lpips::kMinSize || a.height < Lpips::kMinSize)
-        lpips_note = "n/a (image smaller than " + std::to_string(Lpips::kMinSize) + "x" + std::to_string(Lpips::kMinSize) + ")";
+        lpips_note =
+            "n/a (image smaller than " + std::to_string(Lpips::kMinSize) + "x" + std::to_string(Lpips::kMinSize) + ")";
     else {
         const std::string dir = default_lpips_dir(args.vae_dir);
         if (args.vae_dir.empty() && !fs::exists(dir + "/lpips_squeeze_v0.1.safetensors")) {
@@ -133,11 +138,12 @@ int run_metrics(const MetricsArgs& args) {
     }
 
     if (args.json) {
-        std::cout << "{\"a\": " << json_string(args.a) << ", \"b\": " << json_string(args.b) << ", \"width\": " << a.width
-                  << ", \"height\": " << a.height << ", \"channels\": " << a.channels << ", \"kind\": " << json_string(a.latent ? "latent" : "rgb")
-                  << ", \"data_range\": " << json_number(range) << ", \"mse\": " << json_number(mse) << ", \"mse_x100\": " << json_number(mse * 100)
-                  << ", \"psnr\": " << json_number(psnr) << ", \"ssim\": " << json_number(ssim_v) << ", \"lpips\": " << json_number(lpips_v)
-                  << "}\n";
+        std::cout << "{\"a\": " << json_string(args.a) << ", \"b\": " << json_string(args.b)
+                  << ", \"width\": " << a.width << ", \"height\": " << a.height << ", \"channels\": " << a.channels
+                  << ", \"kind\": " << json_string(a.latent ? "latent" : "rgb")
+                  << ", \"data_range\": " << json_number(range) << ", \"mse\": " << json_number(mse)
+                  << ", \"mse_x100\": " << json_number(mse * 100) << ", \"psnr\": " << json_number(psnr)
+                  << ", \"ssim\": " << json_number(ssim_v) << ", \"lpips\": " << json_number(lpips_v) << "}\n";
         return 0;
     }
     std::printf("a: %s (%dx%d, %s)\n", args.a.c_str(), a.width, a.height, a.kind.c_str());

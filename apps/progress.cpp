@@ -47,8 +47,8 @@ bool print_progress(ConsoleState& s, const pipeline::StageProgress& p) {
     s.last = t;
     const int done = p.step - p.start, left = p.total - p.step;
     const double rate = done / std::max(1e-9, p.seconds);
-    std::fprintf(stderr, "%s[%s] %d/%d | %s | %.1f/s | ETA %.0f s%s", style.begin, p.stage, p.step, p.total, p.status.c_str(), rate,
-                 left / std::max(1e-9, rate), style.end);
+    std::fprintf(stderr, "%s[%s] %d/%d | %s | %.1f/s | ETA %.0f s%s", style.begin, p.stage, p.step, p.total,
+                 p.status.c_str(), rate, left / std::max(1e-9, rate), style.end);
     std::fflush(stderr);
     s.line_open = style.begin[0] == '\r';
     if (p.step >= p.total) close_line(s);
@@ -92,16 +92,16 @@ void Progress::update(double fraction, uint64_t rays) {
     m_last = t;
     double el = t - m_start;
     double eta = fraction > 0 ? el * (1.0 - fraction) / fraction : 0.0;
-    std::fprintf(stderr, "%s[%s] %5.1f%% | %6.2f Mrays/s | elapsed %.1f s | ETA %.1f s%s", style.begin, m_label.c_str(), 100.0 * fraction,
-                 el > 0 ? rays / el * 1e-6 : 0.0, el, eta, style.end);
+    std::fprintf(stderr, "%s[%s] %5.1f%% | %6.2f Mrays/s | elapsed %.1f s | ETA %.1f s%s", style.begin, m_label.c_str(),
+                 100.0 * fraction, el > 0 ? rays / el * 1e-6 : 0.0, el, eta, style.end);
     std::fflush(stderr);
 }
 
 void Progress::finish(uint64_t rays) {
     if (!m_enabled) return;
     double el = now() - m_start;
-    std::fprintf(stderr, "%s[%s] done in %.2f s | %.2f Mrays/s%s\n", line_style().begin, m_label.c_str(), el, el > 0 ? rays / el * 1e-6 : 0.0,
-                 stderr_is_terminal() ? "                              " : "");
+    std::fprintf(stderr, "%s[%s] done in %.2f s | %.2f Mrays/s%s\n", line_style().begin, m_label.c_str(), el,
+                 el > 0 ? rays / el * 1e-6 : 0.0, stderr_is_terminal() ? "                              " : "");
 }
 
 }  // namespace lpt::app

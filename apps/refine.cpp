@@ -21,8 +21,8 @@ void show(const nlohmann::json& m, const char* key) {
 }  // namespace
 
 void print_refine_summary(const std::string& fitdir, const pipeline::RefineSummary& s) {
-    std::fprintf(stderr, "wrote %s/{refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json%s}\n", fitdir.c_str(),
-                 s.decoded ? ", decoded_refined.png" : "");
+    std::fprintf(stderr, "wrote %s/{refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json%s}\n",
+                 fitdir.c_str(), s.decoded ? ", decoded_refined.png" : "");
     for (const char* key : {"rendered", "refined", "vae_roundtrip"}) show(s.metrics, key);
 }
 

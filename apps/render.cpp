@@ -25,7 +25,9 @@ int run_render(const RenderArgs& a) {
     if (a.spp > 0) opt.spp = a.spp;
     if (a.max_depth != -2) opt.max_depth = a.max_depth;
     if (!a.res.empty()) parse_resolution(a.res, opt.width, opt.height);
-    opt.strategy = a.strategy == "nee" ? LightStrategy::Nee : a.strategy == "bsdf" ? LightStrategy::Bsdf : LightStrategy::Mis;
+    opt.strategy = a.strategy == "nee"    ? LightStrategy::Nee
+                   : a.strategy == "bsdf" ? LightStrategy::Bsdf
+                                          : LightStrategy::Mis;
     Progress progress("render", !a.quiet);
     std::mutex m;
     opt.progress = [&](double f, uint64_t rays) {
@@ -48,8 +50,8 @@ int run_render(const RenderArgs& a) {
         write_exr(with_suffix(a.out, ".albedo.exr"), Image{aov.width, aov.height, 3, aov.albedo, {"R", "G", "B"}});
     }
     if (!a.quiet)
-        std::cerr << "wrote " << a.out << " and " << with_suffix(a.out, ".png") << " (" << img.width << "x" << img.height << ", " << opt.spp
-                  << " spp, " << stats.rays() << " rays, " << stats.seconds << " s)\n";
+        std::cerr << "wrote " << a.out << " and " << with_suffix(a.out, ".png") << " (" << img.width << "x"
+                  << img.height << ", " << opt.spp << " spp, " << stats.rays() << " rays, " << stats.seconds << " s)\n";
     return 0;
 }
 

@@ -8,7 +8,9 @@ namespace lpt::app {
 
 std::vector<float> load_rgb(const std::string& path, int factor, int& width, int& height) {
     Image img = read_image(path);
-    if (img.channels < 3) throw std::runtime_error(path + ": expected an RGB image, found " + std::to_string(img.channels) + " channel(s)");
+    if (img.channels < 3)
+        throw std::runtime_error(path + ": expected an RGB image, found " + std::to_string(img.channels) +
+                                 " channel(s)");
     if (img.width % factor || img.height % factor)
         throw std::runtime_error(path + ": " + std::to_string(img.width) + "x" + std::to_string(img.height) +
                                  " is not a multiple of the downsampling factor " + std::to_string(factor));
@@ -30,8 +32,8 @@ RenderStack load_stack(const std::vector<std::string>& paths, int target_width) 
         Image probe_dims = read_image(p);  // the factor follows from the first test image's width
         int factor = target_width > 0 ? probe_dims.width / target_width : 1;
         if (factor < 1 || (target_width > 0 && probe_dims.width != factor * target_width))
-            throw std::runtime_error(p + ": width " + std::to_string(probe_dims.width) + " is not a multiple of the test width " +
-                                     std::to_string(target_width));
+            throw std::runtime_error(p + ": width " + std::to_string(probe_dims.width) +
+                                     " is not a multiple of the test width " + std::to_string(target_width));
         int w = 0, h = 0;
         s.renders.push_back(load_rgb(p, factor, w, h));
         if (s.renders.size() > 1 && (w != s.width || h != s.height))
@@ -52,7 +54,8 @@ std::vector<uint8_t> emitter_mask(const Scene& scene, int width, int height) {
             for (int k = 0; k < 16 && !mask[size_t(y) * size_t(width) + size_t(x)]; ++k) {
                 const float ox = -reach + 2.f * reach * (float(k % 4) + 0.5f) / 4.f;
                 const float oy = -reach + 2.f * reach * (float(k / 4) + 0.5f) / 4.f;
-                SurfaceInteraction si = scene.intersect(cam.generate_ray(Vec2f(float(x) + 0.5f + ox, float(y) + 0.5f + oy)));
+                SurfaceInteraction si =
+                    scene.intersect(cam.generate_ray(Vec2f(float(x) + 0.5f + ox, float(y) + 0.5f + oy)));
                 const bool hit_emitter = si.valid() ? scene.shapes[size_t(si.shape)].emitter >= 0 : env;
                 if (hit_emitter) mask[size_t(y) * size_t(width) + size_t(x)] = 1;
             }

@@ -15,7 +15,8 @@ namespace fs = std::filesystem;
 namespace {
 
 std::vector<float> rgb_of(const Image& img, const std::string& path) {
-    if (img.channels < 3) throw std::runtime_error(path + ": needs 3 channels (RGB), has " + std::to_string(img.channels));
+    if (img.channels < 3)
+        throw std::runtime_error(path + ": needs 3 channels (RGB), has " + std::to_string(img.channels));
     std::vector<float> rgb(size_t(img.width) * img.height * 3);
     for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
         for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = img.data[i * img.channels + c];
@@ -33,7 +34,8 @@ int run_encode(const VaeArgs& a) {
     if (ext == ".exr" || ext == ".hdr")
         for (float& v : rgb) v = linear_to_srgb(v);
     std::vector<float> latent = vae->encode(rgb, img.width, img.height);
-    const int c = vae->convention().channels, w = img.width / vae->convention().downsample, h = img.height / vae->convention().downsample;
+    const int c = vae->convention().channels, w = img.width / vae->convention().downsample,
+              h = img.height / vae->convention().downsample;
     write_exr(a.out, Image{w, h, c, latent, {}});
     if (!a.quiet) std::cerr << "wrote " << a.out << " (" << w << "x" << h << "x" << c << ")\n";
     return 0;
@@ -43,7 +45,8 @@ int run_decode(const VaeArgs& a) {
     Image lat = read_image(a.input);
     auto vae = pipeline::open_vae(a.vae);
     if (lat.channels != vae->convention().channels)
-        throw std::runtime_error(a.input + ": " + std::to_string(lat.channels) + " channels, the VAE's latents have " + std::to_string(vae->convention().channels));
+        throw std::runtime_error(a.input + ": " + std::to_string(lat.channels) + " channels, the VAE's latents have " +
+                                 std::to_string(vae->convention().channels));
     std::vector<float> rgb = vae->decode(lat.data, lat.width, lat.height);
     // Decoded values are display-referred (about [0, 1]): EXR keeps them unclamped, PNG as they are.
     const int f = vae->convention().downsample;

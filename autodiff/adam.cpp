@@ -53,8 +53,8 @@ size_t Adam::step(float* params, const float* grads, size_t n, float lr) {
 void Adam::set_state(AdamState state) {
     if (state.m.size() != size() || state.v.size() != size())
         throw std::runtime_error("Adam::set_state: state holds " + std::to_string(state.m.size()) + "/" +
-                                 std::to_string(state.v.size()) + " moments, optimiser has " +
-                                 std::to_string(size()) + " parameters");
+                                 std::to_string(state.v.size()) + " moments, optimiser has " + std::to_string(size()) +
+                                 " parameters");
     if (state.step < 0) throw std::runtime_error("Adam::set_state: negative step count");
     m_state = std::move(state);
 }
@@ -82,8 +82,7 @@ T get(const std::string& in, size_t& pos) {
 }  // namespace
 
 std::string serialize_adam_state(const AdamState& state) {
-    if (state.m.size() != state.v.size())
-        throw std::invalid_argument("serialize_adam_state: m and v differ in size");
+    if (state.m.size() != state.v.size()) throw std::invalid_argument("serialize_adam_state: m and v differ in size");
     const uint64_t n = state.m.size();
     std::string out;
     out.reserve(k_header + 2 * n * sizeof(float));
@@ -103,8 +102,7 @@ AdamState deserialize_adam_state(const std::string& blob) {
         throw std::runtime_error("Adam state: bad magic (not an Adam state blob)");
     size_t pos = sizeof(k_magic);
     const auto version = get<uint32_t>(blob, pos);
-    if (version != k_version)
-        throw std::runtime_error("Adam state: unsupported version " + std::to_string(version));
+    if (version != k_version) throw std::runtime_error("Adam state: unsupported version " + std::to_string(version));
     AdamState state;
     state.step = get<int64_t>(blob, pos);
     const auto n = get<uint64_t>(blob, pos);
@@ -113,8 +111,8 @@ AdamState deserialize_adam_state(const std::string& blob) {
     // nor trigger a huge allocation.
     const uint64_t payload = blob.size() - k_header;
     if (n > payload / (2 * sizeof(float)) || payload != n * 2 * sizeof(float))
-        throw std::runtime_error("Adam state: " + std::to_string(payload) + " payload bytes for " +
-                                 std::to_string(n) + " parameters (truncated or mismatched)");
+        throw std::runtime_error("Adam state: " + std::to_string(payload) + " payload bytes for " + std::to_string(n) +
+                                 " parameters (truncated or mismatched)");
     state.m.resize(n);
     state.v.resize(n);
     if (n == 0) return state;  // memcpy from data() of an empty vector is not guaranteed valid

@@ -30,19 +30,23 @@ RenderOptions iteration_options(const LatentModel& model, const FitOptions& o, i
 }  // namespace
 
 std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone) {
-    std::vector<float> img = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), options).sum();
+    std::vector<float> img =
+        render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), options).sum();
     tone_map(tone, img.data(), img.data(), img.size());
     return img;
 }
 
-FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o, FitState state,
-                    const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
+FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o,
+                    FitState state, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
     const size_t n = size_t(width) * height * kLatentChannels;
-    if (target.size() != n) throw std::invalid_argument("fit: target has " + std::to_string(target.size()) + " values, expected " + std::to_string(n));
+    if (target.size() != n)
+        throw std::invalid_argument("fit: target has " + std::to_string(target.size()) + " values, expected " +
+                                    std::to_string(n));
     size_t bad_index = 0;
     if (!check_finite(target.data(), n, &bad_index))
-        throw std::invalid_argument("fit: target value " + std::to_string(bad_index) + " (pixel " + std::to_string(bad_index / kLatentChannels) +
-                                    ", channel " + std::to_string(bad_index % kLatentChannels) + ") is not finite");
+        throw std::invalid_argument("fit: target value " + std::to_string(bad_index) + " (pixel " +
+                                    std::to_string(bad_index / kLatentChannels) + ", channel " +
+                                    std::to_string(bad_index % kLatentChannels) + ") is not finite");
     ParamStore& ps = model.params();
     Adam adam(ps.raw().size());
     if (!state.adam.m.empty()) adam.set_state(state.adam);
@@ -55,7 +59,8 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
     // Stored paths serve K iterations; a checkpoint falls on a block boundary so that a resumed
     // fit records the same paths from the same parameters as an uninterrupted one.
     const int K = std::max(0, o.reuse_paths);
-    const int checkpoint_every = K > 0 && o.checkpoint_every > 0 ? (o.checkpoint_every + K - 1) / K * K : o.checkpoint_every;
+    const int checkpoint_every =
+        K > 0 && o.checkpoint_every > 0 ? (o.checkpoint_every + K - 1) / K * K : o.checkpoint_every;
     std::optional<PathRecords> records;
     auto t0 = std::chrono::steady_clock::now();
     double seconds_before = state.history.empty() ? 0.0 : state.history.back().seconds;
@@ -63,12 +68,12 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         const RenderOptions ro = iteration_options(model, o, width, height, K > 0 ? it - it % K : it);
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
         std::vector<float> linear;
-        if (K == 0) linear = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro).sum();
+        if (K == 0)
+            linear = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro).sum();
         else if (it % K == 0 || !records) {
             records.reset();  // free the previous frame first: peak memory stays one frame
             records = record_latent_paths(model, ro, &linear);
-        }
-        else linear = replay_forward(model, *records);
+        } else linear = replay_forward(model, *records);
         std::vector<float> toned(n);
         tone_map(o.tone, linear.data(), toned.data(), n);
         double loss = huber_loss(toned.data(), target.data(), n, o.huber_delta, d_toned.data());
@@ -95,7 +100,8 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         double secs = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         FitRecord rec{it, loss, state.smoothed, lr, secs, bad != 0};
         state.history.push_back(rec);
-        if (checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % checkpoint_every == 0) save_checkpoint(o.checkpoint_dir, model, state);
+        if (checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % checkpoint_every == 0)
+            save_checkpoint(o.checkpoint_dir, model, state);
         if (on_iteration && !on_iteration(rec, state)) break;
         if (stop) break;
     }
@@ -152,14 +158,17 @@ FitState load_checkpoint(const std::string& dir, LatentModel& model) {
         s.bad_updates = j.at("bad_updates");
         s.skipped_steps = j.at("skipped_steps");
         s.best_raw = j.at("best_raw").get<std::vector<float>>();
-        for (const auto& r : j.at("history")) s.history.push_back({r.at(0).get<int>(), r.at(1).get<double>(), r.at(2).get<double>(), r.at(3).get<float>(), r.at(4).get<double>()});
+        for (const auto& r : j.at("history"))
+            s.history.push_back({r.at(0).get<int>(), r.at(1).get<double>(), r.at(2).get<double>(), r.at(3).get<float>(),
+                                 r.at(4).get<double>()});
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(state_path + ": incomplete checkpoint: " + e.what());
     }
     const std::string tag = j.value("tag", std::string());
     const std::string params_path = (fs::path(dir) / ("params-" + tag + ".json")).string();
     model.params().load_json(read_file(params_path), params_path);
-    if (s.best_raw.size() != model.params().raw().size()) throw std::runtime_error(state_path + ": best_raw does not match this scene's parameters");
+    if (s.best_raw.size() != model.params().raw().size())
+        throw std::runtime_error(state_path + ": best_raw does not match this scene's parameters");
     model.params().update_values();
     model.sync();
     try {

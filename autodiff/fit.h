@@ -14,23 +14,23 @@ namespace lpt {
 
 struct FitOptions {
     int iterations = 3000;
-    int spp = 16;                 ///< per iteration, fresh random numbers each iteration
+    int spp = 16;  ///< per iteration, fresh random numbers each iteration
     uint64_t seed = 0;
     float lr = 1e-3f, lr_min = 0.f;
     int lr_period = 500, lr_t_mult = 1;
     float huber_delta = 1.f;
     ToneCurve tone = ToneCurve::Clip;
-    int patience = 300;           ///< early stopping on the smoothed loss; 0 = off
+    int patience = 300;  ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
-    float smoothing = 0.95f;      ///< exponential moving average of the noisy per-iteration loss
+    float smoothing = 0.95f;  ///< exponential moving average of the noisy per-iteration loss
     /// 0: fresh paths every iteration, re-traced by the adjoint (path replay, memory of one
     /// wavefront). K >= 1: trace and store one frame's paths every K iterations and replay the
     /// stored paths (forward and adjoint) in between: no rays traced, memory ~56 B per event
     /// (docs/path-replay.md (6), measured in docs/performance.md).
     /// The default, 8, is what `latentpt fit` uses (one source: the CLI shows this value).
     int reuse_paths = 8;
-    int checkpoint_every = 100;   ///< 0 = never; rounded up to a multiple of reuse_paths
-    std::string checkpoint_dir;   ///< empty = no checkpoints
+    int checkpoint_every = 100;  ///< 0 = never; rounded up to a multiple of reuse_paths
+    std::string checkpoint_dir;  ///< empty = no checkpoints
 };
 
 struct FitRecord {
@@ -44,7 +44,7 @@ struct FitRecord {
 struct FitState {
     int next_iteration = 0;
     AdamState adam;
-    double smoothed = -1.0;       ///< < 0 before the first iteration
+    double smoothed = -1.0;  ///< < 0 before the first iteration
     double best_loss = 1e300;
     int best_iteration = -1, bad_updates = 0;
     std::vector<float> best_raw;  ///< the parameters at best_iteration
@@ -57,8 +57,9 @@ std::vector<float> render_toned(const LatentModel& model, const RenderOptions& o
 
 /// Runs (or continues, from `state`) the fit; ends with the best parameters in `model`.
 /// `on_iteration` is called after every iteration (progress, logging); returning false stops.
-FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& options,
-                    FitState state = {}, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration = {});
+FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height,
+                    const FitOptions& options, FitState state = {},
+                    const std::function<bool(const FitRecord&, const FitState&)>& on_iteration = {});
 
 /// Checkpoint = params (raw) + Adam state + early-stopping state + history, written atomically
 /// into `dir`; load throws std::runtime_error naming the file on any mismatch.

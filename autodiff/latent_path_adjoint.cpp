@@ -13,7 +13,12 @@ namespace {
 class Adjoint final : public detail::PathRecorder {
 public:
     Adjoint(const LatentModel& model, const RenderOptions& opt, const std::vector<float>& d_image, int n_tiles)
-        : PathRecorder(n_tiles), m_model(model), m_sampler{opt.seed, opt.sampler}, m_d_image(d_image), m_inv_spp(1.f / float(opt.spp)), m_tile_grads(n_tiles) {}
+        : PathRecorder(n_tiles),
+          m_model(model),
+          m_sampler{opt.seed, opt.sampler},
+          m_d_image(d_image),
+          m_inv_spp(1.f / float(opt.spp)),
+          m_tile_grads(n_tiles) {}
 
     /// Sums the per-tile buffers in tile order into `out` (deterministic).
     void reduce(std::vector<float>& out) const {
@@ -39,14 +44,16 @@ private:
 
 }  // namespace
 
-std::vector<float> backward_latent(LatentModel& model, const RenderOptions& opt, const std::vector<float>& d_image, RenderStats* stats) {
+std::vector<float> backward_latent(LatentModel& model, const RenderOptions& opt, const std::vector<float>& d_image,
+                                   RenderStats* stats) {
     const Scene& scene = model.scene();
     const int w = opt.width > 0 ? opt.width : scene.camera.width, h = opt.height > 0 ? opt.height : scene.camera.height;
     if (d_image.size() != size_t(w) * h * kLatentChannels)
-        throw std::invalid_argument("backward_latent: d_image has " + std::to_string(d_image.size()) + " floats, expected " +
-                                    std::to_string(size_t(w) * h * kLatentChannels));
+        throw std::invalid_argument("backward_latent: d_image has " + std::to_string(d_image.size()) +
+                                    " floats, expected " + std::to_string(size_t(w) * h * kLatentChannels));
     Adjoint adjoint(model, opt, d_image, render_tile_count(w, h));
-    TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(scene, model.spectra(), model.terms(), opt, stats, &adjoint);
+    TermFilms<kLatentChannels> films =
+        render_latent_terms<kLatentChannels>(scene, model.spectra(), model.terms(), opt, stats, &adjoint);
     adjoint.reduce(model.params().grad_values());
     return films.sum();
 }

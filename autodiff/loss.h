@@ -9,8 +9,7 @@ namespace lpt {
 /// Matches torch.nn.HuberLoss(reduction="mean", delta). If d_pred is non-null it is overwritten
 /// (not accumulated) with ∂loss/∂pred, docs/fitting.md (8). Sums in double.
 /// Throws std::invalid_argument if n == 0 or delta <= 0 (or is not finite).
-double huber_loss(const float* pred, const float* target, size_t n, float delta = 1.0f,
-                  float* d_pred = nullptr);
+double huber_loss(const float* pred, const float* target, size_t n, float delta = 1.0f, float* d_pred = nullptr);
 
 /// Mean squared error (1/n) Σ (pred − target)², docs/fitting.md (9); d_pred = 2 (pred − target) / n
 /// when non-null (overwritten). Throws std::invalid_argument if n == 0.

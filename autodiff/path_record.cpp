@@ -19,7 +19,9 @@ size_t PathRecords::events() const {
 size_t PathRecords::bytes() const {
     size_t n = 0;
     for (const auto& t : tiles)
-        for (const PathBlock& b : t) n += b.events.capacity() * sizeof(PathEvent) + (b.pixel.capacity() + b.sample.capacity() + b.begin.capacity()) * sizeof(uint32_t);
+        for (const PathBlock& b : t)
+            n += b.events.capacity() * sizeof(PathEvent) +
+                 (b.pixel.capacity() + b.sample.capacity() + b.begin.capacity()) * sizeof(uint32_t);
     return n;
 }
 
@@ -27,7 +29,7 @@ namespace detail {
 
 struct PathRecorder::Scratch {
     int tile = 0;
-    std::vector<std::vector<PathEvent>> paths;          ///< per slot, in event order
+    std::vector<std::vector<PathEvent>> paths;           ///< per slot, in event order
     std::vector<std::pair<uint32_t, uint32_t>> pending;  ///< shadow id → (slot, event index)
     PathBlock block;                                     ///< reused when complete() keeps nothing
 };
@@ -80,8 +82,8 @@ void PathRecorder::ambient(uint32_t slot, int shape) {
     scratch().paths[slot].push_back(e);
 }
 
-void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emitter, float w_over_pdf, const BSDFContext& ctx,
-                                const Vec3f& wi, const Vec3f& wo, bool nee, bool first) {
+void PathRecorder::light_sample(uint32_t slot, int shadow_id, int shape, int emitter, float w_over_pdf,
+                                const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, bool nee, bool first) {
     PathEvent e;
     e.type = PathEvent::Light;
     e.shape = shape;
@@ -105,8 +107,8 @@ void PathRecorder::shadow(int shadow_id, bool blocked) {
     if (!blocked) s.paths[slot][idx].flags |= PathEvent::kVisible;
 }
 
-void PathRecorder::bounce(uint32_t slot, int shape, const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<kLatentChannels>& bs,
-                          float q, int depth) {
+void PathRecorder::bounce(uint32_t slot, int shape, const BSDFContext& ctx, const Vec3f& wi,
+                          const BSDFSample<kLatentChannels>& bs, float q, int depth) {
     PathEvent e;
     e.type = PathEvent::Bounce;
     e.shape = shape;
@@ -162,7 +164,8 @@ BSDFSample<kLatentChannels> sample_of(const PathEvent& e) {
 /// f·|cos|/p with the recorded direction and pdf. Delta lobes have no density to divide by, so
 /// the BSDF samples again with the path's own random numbers: its lobe choice and direction
 /// depend on geometry only (core/bsdf.h), so it returns the recorded lobe with today's value.
-L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, SamplerId sampler, uint32_t pixel, uint32_t sample) {
+L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, SamplerId sampler, uint32_t pixel,
+                uint32_t sample) {
     if (e.lobe & kDelta) {
         const BsdfRandoms u = bsdf_randoms(sampler.stream(pixel, sample), e.depth);
         BSDFSample<kLatentChannels> bs = bsdf.sample(context_of(e), e.wi, u.lobe, Vec2f(u.dir[0], u.dir[1]));
@@ -173,7 +176,8 @@ L bounce_weight(const BSDF<kLatentChannels>& bsdf, const PathEvent& e, SamplerId
 
 /// Throughput in front of each event (beta) and each event's local factor (local): a visible
 /// NEE sample's BSDF value f, a bounce's weight/q. docs/path-replay.md (1).
-void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint32_t sample, const PathEvent* ev, size_t n, PathScratch& s) {
+void sweep_forward(const LatentModel& m, SamplerId sampler, uint32_t pixel, uint32_t sample, const PathEvent* ev,
+                   size_t n, PathScratch& s) {
     if (s.beta.size() < n) {
         s.beta.resize(n);
         s.local.resize(n);
@@ -211,7 +215,8 @@ PathScratch& path_scratch() {
 
 }  // namespace
 
-void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& block, const float* d_image, float inv_spp, float* g) {
+void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& block, const float* d_image,
+                    float inv_spp, float* g) {
     const ParamStore& ps = m.params();
     const auto& terms = m.terms();
     const auto& radiance = m.spectra().radiance;
@@ -256,8 +261,10 @@ void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& bl
                     const BSDF<kLatentChannels>& bsdf = m.spectra().bsdf_of(m.scene(), e.shape);
                     const BSDFContext ctx = context_of(e);
                     const auto& keys = m.slots(e.shape).bsdf;
-                    for (size_t c = 0; c < keys.size(); ++c) add(keys[c].second, d * beta * bsdf.eval_grad(ctx, e.wi, e.wo, int(c)) * (e.w_over_pdf * le));
-                    if (!m.slots(e.shape).scalar.empty()) add_scalar(e.shape, d * beta * bsdf.eval_grad_scalar(ctx, e.wi, e.wo, 0) * (e.w_over_pdf * le));
+                    for (size_t c = 0; c < keys.size(); ++c)
+                        add(keys[c].second, d * beta * bsdf.eval_grad(ctx, e.wi, e.wo, int(c)) * (e.w_over_pdf * le));
+                    if (!m.slots(e.shape).scalar.empty())
+                        add_scalar(e.shape, d * beta * bsdf.eval_grad_scalar(ctx, e.wi, e.wo, 0) * (e.w_over_pdf * le));
                     break;
                 }
                 case PathEvent::Bounce: {
@@ -266,7 +273,8 @@ void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& bl
                     const BSDFSample<kLatentChannels> bs = sample_of(e);
                     const float inv_q = 1.f / e.survival;
                     const auto& keys = m.slots(e.shape).bsdf;
-                    for (size_t c = 0; c < keys.size(); ++c) add(keys[c].second, d * beta * bsdf.weight_grad(ctx, e.wi, bs, int(c)) * (inv_q * R));
+                    for (size_t c = 0; c < keys.size(); ++c)
+                        add(keys[c].second, d * beta * bsdf.weight_grad(ctx, e.wi, bs, int(c)) * (inv_q * R));
                     if (!m.slots(e.shape).scalar.empty() && !(e.lobe & kDelta))
                         add_scalar(e.shape, d * beta * bsdf.weight_grad_scalar(ctx, e.wi, bs, 0) * (inv_q * R));
                     R = s.local[i] * R;
@@ -279,7 +287,8 @@ void backward_block(const LatentModel& m, SamplerId sampler, const PathBlock& bl
 
 }  // namespace detail
 
-PathRecords record_latent_paths(const LatentModel& model, const RenderOptions& opt, std::vector<float>* image, RenderStats* stats) {
+PathRecords record_latent_paths(const LatentModel& model, const RenderOptions& opt, std::vector<float>* image,
+                                RenderStats* stats) {
     const Scene& scene = model.scene();
     PathRecords r;
     r.sampler = {opt.seed, opt.sampler};
@@ -287,7 +296,8 @@ PathRecords record_latent_paths(const LatentModel& model, const RenderOptions& o
     r.height = opt.height > 0 ? opt.height : scene.camera.height;
     r.spp = opt.spp;
     detail::PathRecorder recorder(render_tile_count(r.width, r.height));
-    TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(scene, model.spectra(), model.terms(), opt, stats, &recorder);
+    TermFilms<kLatentChannels> films =
+        render_latent_terms<kLatentChannels>(scene, model.spectra(), model.terms(), opt, stats, &recorder);
     if (image) *image = films.sum();
     r.tiles = std::move(recorder.records());
     return r;
@@ -316,7 +326,8 @@ std::vector<float> replay_forward(const LatentModel& m, const PathRecords& r) {
                         a_sum += ambient_score(beta, e.shape < 0 ? terms.background : terms.La[e.shape]);
                     } else if (e.type == PathEvent::Light) {
                         if (detail::gate_open(m, e)) c_sum += occlusion_score(beta, terms.Lc[e.shape]);
-                        if (detail::visible_nee(e)) e_sum += nee_score(beta, s.local[i], radiance[e.emitter], e.w_over_pdf);
+                        if (detail::visible_nee(e))
+                            e_sum += nee_score(beta, s.local[i], radiance[e.emitter], e.w_over_pdf);
                     }
                 }
                 films.e.add_sample(int(block.pixel[k]), e_sum);
@@ -330,14 +341,16 @@ std::vector<float> replay_forward(const LatentModel& m, const PathRecords& r) {
 
 void replay_backward(LatentModel& m, const PathRecords& r, const std::vector<float>& d_image) {
     if (d_image.size() != size_t(r.width) * r.height * kLatentChannels)
-        throw std::invalid_argument("replay_backward: d_image has " + std::to_string(d_image.size()) + " floats, expected " +
+        throw std::invalid_argument("replay_backward: d_image has " + std::to_string(d_image.size()) +
+                                    " floats, expected " +
                                     std::to_string(size_t(r.width) * r.height * kLatentChannels));
     const size_t n_values = m.params().grad_values().size();
     std::vector<std::vector<float>> tile_grads(r.tiles.size());
     tbb::parallel_for(0, int(r.tiles.size()), [&](int t) {
         if (r.tiles[t].empty()) return;
         tile_grads[t].assign(n_values, 0.f);
-        for (const PathBlock& block : r.tiles[t]) detail::backward_block(m, r.sampler, block, d_image.data(), 1.f / float(r.spp), tile_grads[t].data());
+        for (const PathBlock& block : r.tiles[t])
+            detail::backward_block(m, r.sampler, block, d_image.data(), 1.f / float(r.spp), tile_grads[t].data());
     });
     // Summed in tile order: bit-identical at any thread count (docs/path-replay.md (5)).
     std::vector<float>& out = m.params().grad_values();

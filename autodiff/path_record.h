@@ -55,8 +55,8 @@ struct PathRecords {
 
 /// Renders Ĩe, Ĩa, Ĩc with `options` and keeps every path's record. `image` (optional) receives
 /// the primal Ĩ of the same pass (N floats per pixel).
-PathRecords record_latent_paths(const LatentModel& model, const RenderOptions& options, std::vector<float>* image = nullptr,
-                                RenderStats* stats = nullptr);
+PathRecords record_latent_paths(const LatentModel& model, const RenderOptions& options,
+                                std::vector<float>* image = nullptr, RenderStats* stats = nullptr);
 
 /// Ĩ of the recorded paths with the model's current values; equals the primal of the same
 /// options (up to float rounding) while the coefficients are those of the recording.
@@ -80,8 +80,8 @@ public:
     void light_sample(uint32_t slot, int shadow_id, int shape, int emitter, float w_over_pdf, const BSDFContext& ctx,
                       const Vec3f& wi, const Vec3f& wo, bool nee, bool first) override;
     void shadow(int shadow_id, bool blocked) override;
-    void bounce(uint32_t slot, int shape, const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<kLatentChannels>& bs,
-                float q, int depth) override;
+    void bounce(uint32_t slot, int shape, const BSDFContext& ctx, const Vec3f& wi,
+                const BSDFSample<kLatentChannels>& bs, float q, int depth) override;
     void end(const uint32_t* pixel, const uint32_t* sample, size_t n) override;
     std::vector<std::vector<PathBlock>>& records() { return m_records; }
 
@@ -89,15 +89,16 @@ protected:
     virtual void complete(int tile, PathBlock& block) { m_records[tile].push_back(std::move(block)); }
 
 private:
-    struct Scratch;  ///< one thread's wavefront under construction
-    struct Threads;  ///< every thread's Scratch
+    struct Scratch;            ///< one thread's wavefront under construction
+    struct Threads;            ///< every thread's Scratch
     Scratch& scratch() const;  ///< this thread's, for this recorder
     std::unique_ptr<Threads> m_threads;
     std::vector<std::vector<PathBlock>> m_records;
 };
 
 /// Gradient sweep of one block: adds into `grad` (the ParamStore's value layout).
-void backward_block(const LatentModel& model, SamplerId sampler, const PathBlock& block, const float* d_image, float inv_spp, float* grad);
+void backward_block(const LatentModel& model, SamplerId sampler, const PathBlock& block, const float* d_image,
+                    float inv_spp, float* grad);
 
 }  // namespace detail
 

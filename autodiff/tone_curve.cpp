@@ -72,10 +72,14 @@ ToneCurve parse_tone_curve(const std::string& name) {
 
 const char* to_string(ToneCurve curve) {
     switch (curve) {
-        case ToneCurve::Clip: return "clip";
-        case ToneCurve::Reinhard: return "reinhard";
-        case ToneCurve::None: return "none";
-        case ToneCurve::Logit: return "logit";
+        case ToneCurve::Clip:
+            return "clip";
+        case ToneCurve::Reinhard:
+            return "reinhard";
+        case ToneCurve::None:
+            return "none";
+        case ToneCurve::Logit:
+            return "logit";
     }
     return "none";
 }

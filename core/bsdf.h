@@ -42,8 +42,8 @@ struct BSDFSample {
     /// Solid-angle pdf of wo for non-delta lobes; for a delta lobe, the discrete probability of
     /// having chosen that lobe. 0 marks a failed sample.
     float pdf = 0.f;
-    float eta = 1.f;            ///< relative IOR across the interface for a transmission, else 1
-    uint32_t lobe = kNoLobe;    ///< the single BSDFFlags bit of the sampled lobe
+    float eta = 1.f;                           ///< relative IOR across the interface for a transmission, else 1
+    uint32_t lobe = kNoLobe;                   ///< the single BSDFFlags bit of the sampled lobe
     Spectrum<N> weight = Spectrum<N>::Zero();  ///< f * |cos wo| / pdf (delta: the lobe's value / pdf)
     bool valid() const { return pdf > 0.f; }
 };
@@ -61,7 +61,8 @@ template <int N>
 BSDFSample<N> lambertian_sample(Lambertian sides, const Vec3f& wi, const Vec3f& wo, const Spectrum<N>& reflectance) {
     const bool below = sides == Lambertian::TwoSided && cos_theta(wi) < 0.f;
     BSDFSample<N> bs;
-    if ((below ? -cos_theta(wi) : cos_theta(wi)) <= 0.f || !(cos_theta(wo) > 0.f)) return bs;  // wo on the horizon: eval = 0
+    if ((below ? -cos_theta(wi) : cos_theta(wi)) <= 0.f || !(cos_theta(wo) > 0.f))
+        return bs;  // wo on the horizon: eval = 0
     bs.wo = below ? Vec3f(wo.x(), wo.y(), -wo.z()) : wo;
     bs.pdf = cos_theta(wo) * kInvPi;
     bs.lobe = kDiffuseReflection;
@@ -125,7 +126,8 @@ public:
         throw std::logic_error("this BSDF type has no scalar-parameter gradients");
     }
     /// ∂(bs.weight)/∂s with the sampled direction and its pdf held fixed: (∂f/∂s)/pdf by default.
-    virtual Spectrum<N> weight_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const {
+    virtual Spectrum<N> weight_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs,
+                                           int key) const {
         return eval_grad_scalar(ctx, wi, bs.wo, key) / bs.pdf;
     }
 

@@ -35,8 +35,11 @@ public:
     /// Camera rays for n samples at once, the floats of filter.sample + generate_ray one by one:
     /// pixel (px, py) + 0.5 + the filter offset from (u0, u1), written into Embree-layout arrays
     /// (origin, direction, tnear, tfar). Evaluated 4-8 wide (tests/integrators/test_lights_camera.cpp).
-    struct RayOut { float *ox, *oy, *oz, *dx, *dy, *dz, *tnear, *tfar; };
-    void generate_rays(size_t n, const float* px, const float* py, const float* u0, const float* u1, const Vec2f& tan_half, const RayOut& out) const;
+    struct RayOut {
+        float *ox, *oy, *oz, *dx, *dy, *dz, *tnear, *tfar;
+    };
+    void generate_rays(size_t n, const float* px, const float* py, const float* u0, const float* u1,
+                       const Vec2f& tan_half, const RayOut& out) const;
     /// Same camera at another resolution (fov semantics kept, e.g. latent res = image / 8).
     Camera with_resolution(int w, int h) const;
     /// Camera-space tangents of the half field of view in x and y.

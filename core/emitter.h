@@ -16,21 +16,21 @@ class EnvMap;
 
 struct Emitter {
     EmitterKind kind = EmitterKind::Area;
-    int shape = -1;                 ///< emitting shape (Area only)
+    int shape = -1;  ///< emitting shape (Area only)
     /// As described in the scene file; for an EnvMap its mean radiance over the sphere (light
     /// selection by power, and the latent environment's starting value).
     Eigen::Array3f radiance_rgb = Eigen::Array3f::Ones();
-    Props props;                    ///< the description, for error messages and other N
+    Props props;                           ///< the description, for error messages and other N
     std::shared_ptr<const EnvMap> envmap;  ///< EnvMap only
     bool is_environment() const { return kind != EmitterKind::Area; }
 };
 
 struct LightSample {
-    Vec3f p = Vec3f::Zero();   ///< point on the light (Area)
-    Vec3f n = Vec3f::UnitZ();  ///< its emission normal
-    Vec3f wi = Vec3f::UnitZ(); ///< unit direction from the reference point toward the light
-    float dist = kInf;         ///< distance to the light point (inf for the environment)
-    float pdf = 0.f;           ///< solid angle at the reference point, light choice included
+    Vec3f p = Vec3f::Zero();    ///< point on the light (Area)
+    Vec3f n = Vec3f::UnitZ();   ///< its emission normal
+    Vec3f wi = Vec3f::UnitZ();  ///< unit direction from the reference point toward the light
+    float dist = kInf;          ///< distance to the light point (inf for the environment)
+    float pdf = 0.f;            ///< solid angle at the reference point, light choice included
     int emitter = -1;
     bool valid() const { return pdf > 0.f; }
 };

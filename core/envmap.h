@@ -45,8 +45,8 @@ private:
     float m_scale;
     Eigen::Array3f m_mean = Eigen::Array3f::Zero();
     float m_mean_luminance = 0.f;
-    std::vector<float> m_texel_pmf;            ///< per texel, sums to 1
-    std::vector<float> m_row_cdf, m_col_cdf;   ///< H + 1 entries; H × (W + 1) entries
+    std::vector<float> m_texel_pmf;           ///< per texel, sums to 1
+    std::vector<float> m_row_cdf, m_col_cdf;  ///< H + 1 entries; H × (W + 1) entries
 };
 
 }  // namespace lpt

@@ -9,13 +9,19 @@ namespace lpt {
 class SceneError : public std::runtime_error {
 public:
     SceneError(const std::string& file, const std::string& field, const std::string& message, int line = -1)
-        : std::runtime_error(format(file, field, message, line)), m_file(file), m_field(field), m_message(message), m_line(line) {}
+        : std::runtime_error(format(file, field, message, line)),
+          m_file(file),
+          m_field(field),
+          m_message(message),
+          m_line(line) {}
     const std::string& file() const { return m_file; }
     const std::string& field() const { return m_field; }
     /// The message alone, without file, line and field.
     const std::string& message() const { return m_message; }
     /// The same error with `more` appended to its message (e.g. which shapes use a material).
-    SceneError with_note(const std::string& more) const { return SceneError(m_file, m_field, m_message + more, m_line); }
+    SceneError with_note(const std::string& more) const {
+        return SceneError(m_file, m_field, m_message + more, m_line);
+    }
 
 private:
     static std::string format(const std::string& file, const std::string& field, const std::string& msg, int line) {

@@ -10,7 +10,11 @@ namespace lpt {
 template <int N>
 class Film {
 public:
-    Film(int width, int height) : m_width(width), m_height(height), m_sum(size_t(width) * height, Spectrum<N>::Zero()), m_weight(size_t(width) * height, 0.f) {}
+    Film(int width, int height)
+        : m_width(width),
+          m_height(height),
+          m_sum(size_t(width) * height, Spectrum<N>::Zero()),
+          m_weight(size_t(width) * height, 0.f) {}
     int width() const { return m_width; }
     int height() const { return m_height; }
     void add_sample(int pixel, const Spectrum<N>& value, float weight = 1.f) {

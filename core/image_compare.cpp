@@ -56,8 +56,8 @@ void ratio_with_noise(double a, double var_a, double b, double var_b, double& ra
 }
 
 /// One block's channel-average ratio with its noise; masked pixels left out.
-BlockComparison compare_block(const StackMoments& t, const StackMoments& r, const std::vector<uint8_t>& emitter_mask, int w, int h,
-                              int x0, int y0, int block_size, double z_threshold) {
+BlockComparison compare_block(const StackMoments& t, const StackMoments& r, const std::vector<uint8_t>& emitter_mask,
+                              int w, int h, int x0, int y0, int block_size, double z_threshold) {
     BlockComparison b;
     b.x0 = x0;
     b.y0 = y0;
@@ -91,17 +91,18 @@ BlockComparison compare_block(const StackMoments& t, const StackMoments& r, cons
 
 }  // namespace
 
-ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref, const std::vector<uint8_t>& emitter_mask,
-                                int block_size, double z_threshold) {
+ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref,
+                                const std::vector<uint8_t>& emitter_mask, int block_size, double z_threshold) {
     check_stack(test, "test");
     check_stack(ref, "reference");
     if (test.width != ref.width || test.height != ref.height)
-        throw std::invalid_argument("test is " + std::to_string(test.width) + "x" + std::to_string(test.height) + ", reference " +
-                                    std::to_string(ref.width) + "x" + std::to_string(ref.height));
+        throw std::invalid_argument("test is " + std::to_string(test.width) + "x" + std::to_string(test.height) +
+                                    ", reference " + std::to_string(ref.width) + "x" + std::to_string(ref.height));
     if (block_size < 1) throw std::invalid_argument("block size must be >= 1");
     const int w = test.width, h = test.height;
     const size_t n = size_t(w) * size_t(h);
-    if (!emitter_mask.empty() && emitter_mask.size() != n) throw std::invalid_argument("emitter mask size differs from the images");
+    if (!emitter_mask.empty() && emitter_mask.size() != n)
+        throw std::invalid_argument("emitter mask size differs from the images");
     const StackMoments t = moments(test), r = moments(ref);
     auto masked = [&](size_t p) { return !emitter_mask.empty() && emitter_mask[p] != 0; };
 
@@ -135,8 +136,8 @@ ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref,
     for (int ch = 0; ch < 3; ++ch) {
         c.test_mean[ch] *= inv;
         c.ref_mean[ch] *= inv;
-        ratio_with_noise(c.test_mean[ch], var_t[ch] * inv * inv, c.ref_mean[ch], var_r[ch] * inv * inv, c.mean_ratio[ch],
-                         c.mean_ratio_sigma[ch]);
+        ratio_with_noise(c.test_mean[ch], var_t[ch] * inv * inv, c.ref_mean[ch], var_r[ch] * inv * inv,
+                         c.mean_ratio[ch], c.mean_ratio_sigma[ch]);
     }
     c.rel_mse = rel / double(used * 3);
 
@@ -145,7 +146,8 @@ ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref,
     c.blocks_y = (h + block_size - 1) / block_size;
     for (int by = 0; by < c.blocks_y; ++by)
         for (int bx = 0; bx < c.blocks_x; ++bx) {
-            c.blocks.push_back(compare_block(t, r, emitter_mask, w, h, bx * block_size, by * block_size, block_size, z_threshold));
+            c.blocks.push_back(
+                compare_block(t, r, emitter_mask, w, h, bx * block_size, by * block_size, block_size, z_threshold));
             c.flagged += c.blocks.back().flagged ? 1 : 0;
         }
     return c;
@@ -159,8 +161,9 @@ std::string format_comparison(const ImageComparison& c, const std::string& test_
     o << "emitter pixels left out: " << c.masked_pixels << "\n";
     const char* names[3] = {"R", "G", "B"};
     for (int ch = 0; ch < 3; ++ch) {
-        std::snprintf(buf, sizeof buf, "mean %s: test %.6g  ref %.6g  ratio %.4f ± %.4f (%+.2f %%)\n", names[ch], c.test_mean[ch],
-                      c.ref_mean[ch], c.mean_ratio[ch], c.mean_ratio_sigma[ch], 100.0 * (c.mean_ratio[ch] - 1.0));
+        std::snprintf(buf, sizeof buf, "mean %s: test %.6g  ref %.6g  ratio %.4f ± %.4f (%+.2f %%)\n", names[ch],
+                      c.test_mean[ch], c.ref_mean[ch], c.mean_ratio[ch], c.mean_ratio_sigma[ch],
+                      100.0 * (c.mean_ratio[ch] - 1.0));
         o << buf;
     }
     std::snprintf(buf, sizeof buf, "relMSE (emitters masked): %.6g\n", c.rel_mse);
@@ -194,8 +197,8 @@ std::string format_comparison(const ImageComparison& c, const std::string& test_
     o << buf;
     for (const auto& b : c.blocks) {
         if (!b.flagged) continue;
-        std::snprintf(buf, sizeof buf, "  block x %4d..%-4d y %4d..%-4d ratio %.4f ± %.4f  z %+.1f\n", b.x0, b.x0 + b.width - 1, b.y0,
-                      b.y0 + b.height - 1, b.ratio, b.sigma, b.z);
+        std::snprintf(buf, sizeof buf, "  block x %4d..%-4d y %4d..%-4d ratio %.4f ± %.4f  z %+.1f\n", b.x0,
+                      b.x0 + b.width - 1, b.y0, b.y0 + b.height - 1, b.ratio, b.sigma, b.z);
         o << buf;
     }
     return o.str();
@@ -214,8 +217,10 @@ std::vector<float> ratio_map(const ImageComparison& c, int width, int height, do
         }
         for (int y = b.y0; y < b.y0 + b.height && y < height; ++y) {
             for (int x = b.x0; x < b.x0 + b.width && x < width; ++x) {
-                const bool edge = b.flagged && (x == b.x0 || y == b.y0 || x == b.x0 + b.width - 1 || y == b.y0 + b.height - 1);
-                for (int ch = 0; ch < 3; ++ch) img[(size_t(y) * size_t(width) + size_t(x)) * 3 + ch] = edge ? 0.f : rgb[ch];
+                const bool edge =
+                    b.flagged && (x == b.x0 || y == b.y0 || x == b.x0 + b.width - 1 || y == b.y0 + b.height - 1);
+                for (int ch = 0; ch < 3; ++ch)
+                    img[(size_t(y) * size_t(width) + size_t(x)) * 3 + ch] = edge ? 0.f : rgb[ch];
             }
         }
     }

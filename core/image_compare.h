@@ -22,16 +22,16 @@ struct RenderStack {
 
 struct BlockComparison {
     int x0 = 0, y0 = 0, width = 0, height = 0;  ///< pixel rectangle
-    int pixels = 0;                              ///< unmasked pixels used
-    double test_mean = 0, ref_mean = 0;          ///< mean over unmasked pixels of (R + G + B) / 3
-    double ratio = 1, sigma = 0;                 ///< test / ref and its 1σ noise
-    double z = 0;                                ///< (ratio − 1) / sigma; 0 when sigma is 0
-    bool flagged = false;                        ///< |z| > threshold
+    int pixels = 0;                             ///< unmasked pixels used
+    double test_mean = 0, ref_mean = 0;         ///< mean over unmasked pixels of (R + G + B) / 3
+    double ratio = 1, sigma = 0;                ///< test / ref and its 1σ noise
+    double z = 0;                               ///< (ratio − 1) / sigma; 0 when sigma is 0
+    bool flagged = false;                       ///< |z| > threshold
 };
 
 struct ImageComparison {
     std::array<double, 3> test_mean{}, ref_mean{}, mean_ratio{}, mean_ratio_sigma{};  ///< unmasked pixels
-    double rel_mse = 0;          ///< mean over unmasked pixels and channels of (t − r)² / (r² + 0.01)
+    double rel_mse = 0;  ///< mean over unmasked pixels and channels of (t − r)² / (r² + 0.01)
     int masked_pixels = 0;
     bool test_noise_known = false, ref_noise_known = false;
     int block_size = 32;
@@ -45,8 +45,9 @@ struct ImageComparison {
 /// nonzero = leave out) removes directly seen emitters, whose huge values would otherwise dominate
 /// means and ratios through filter differences at their edges; empty = no mask. Throws
 /// std::invalid_argument for mismatched sizes or empty stacks.
-ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref, const std::vector<uint8_t>& emitter_mask,
-                                int block_size = 32, double z_threshold = 3.0);
+ImageComparison compare_renders(const RenderStack& test, const RenderStack& ref,
+                                const std::vector<uint8_t>& emitter_mask, int block_size = 32,
+                                double z_threshold = 3.0);
 
 /// A plain-text table of the comparison: means, ratios with their noise, relMSE, flagged blocks.
 std::string format_comparison(const ImageComparison& c, const std::string& test_name, const std::string& ref_name);

@@ -17,7 +17,8 @@ namespace {
 std::string temp_path_for(const std::string& path) {
     fs::path p(path);
     // Keep the extension last: OIIO chooses the format from it.
-    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + p.extension().string())).string();
+    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + p.extension().string()))
+        .string();
 }
 
 void write_oiio(const std::string& path, const OIIO::ImageSpec& spec, const void* data) {
@@ -46,7 +47,8 @@ void reorder_numbered_channels(Image& img) {
     std::vector<std::string> names(img.channels);
     for (int c = 0; c < img.channels; ++c) {
         names[c] = img.channel_names[order[c].second];
-        for (size_t i = 0; i < size_t(img.width) * img.height; ++i) data[i * img.channels + c] = img.data[i * img.channels + order[c].second];
+        for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
+            data[i * img.channels + c] = img.data[i * img.channels + order[c].second];
     }
     img.data = std::move(data);
     img.channel_names = std::move(names);

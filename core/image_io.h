@@ -9,7 +9,7 @@ namespace lpt {
 
 struct Image {
     int width = 0, height = 0, channels = 0;
-    std::vector<float> data;               ///< interleaved, row-major from the top-left
+    std::vector<float> data;  ///< interleaved, row-major from the top-left
     std::vector<std::string> channel_names;
 };
 

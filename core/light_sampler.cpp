@@ -6,7 +6,8 @@
 
 namespace lpt {
 
-void LightSampler::build(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, LightSampling mode, float scene_radius) {
+void LightSampler::build(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, LightSampling mode,
+                         float scene_radius) {
     m_pmf.assign(emitters.size(), 0.f);
     m_cdf.assign(emitters.size(), 0.f);
     if (emitters.empty()) return;
@@ -47,12 +48,13 @@ int LightSampler::choose(float u, float* u_reuse) const {
     return i;
 }
 
-LightSample LightSampler::sample(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, const Vec3f& ref,
-                                 float u_choice, const Vec2f& u_pos) const {
+LightSample LightSampler::sample(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes,
+                                 const Vec3f& ref, float u_choice, const Vec2f& u_pos) const {
     float u_tri;
     int i = choose(u_choice, &u_tri);
     const Emitter& e = emitters[i];
-    LightSample ls = e.kind == EmitterKind::Area     ? sample_area_light(shapes[e.shape], ref, Eigen::Vector3f(u_tri, u_pos.x(), u_pos.y()))
+    LightSample ls = e.kind == EmitterKind::Area
+                         ? sample_area_light(shapes[e.shape], ref, Eigen::Vector3f(u_tri, u_pos.x(), u_pos.y()))
                      : e.kind == EmitterKind::EnvMap ? e.envmap->sample(u_pos)
                                                      : sample_constant_light(u_pos);
     ls.emitter = i;
@@ -61,8 +63,8 @@ LightSample LightSampler::sample(const std::vector<Emitter>& emitters, const std
 }
 
 void LightBatch::resize(size_t n) {
-    for (auto* a : {&rx, &ry, &rz, &u_choice, &u_pos0, &u_pos1, &px, &py, &pz, &nx, &ny, &nz, &wx, &wy, &wz, &dist, &pdf,
-                    &ax, &ay, &az, &bx, &by, &bz, &cx, &cy, &cz, &pdf_area})
+    for (auto* a : {&rx, &ry,   &rz,  &u_choice, &u_pos0, &u_pos1, &px, &py, &pz, &nx, &ny, &nz, &wx,      &wy,
+                    &wz, &dist, &pdf, &ax,       &ay,     &az,     &bx, &by, &bz, &cx, &cy, &cz, &pdf_area})
         if (a->size() < n) a->resize(n);
     if (emitter.size() < n) emitter.resize(n);
     if (scalar.size() < n) scalar.resize(n);
@@ -76,16 +78,32 @@ namespace {
 // (reference point on the light, light facing away) get pdf 0, as sample() does.
 LPT_VECTOR_CLONES
 void triangle_light_geometry(LightBatch& b, size_t n) {
-    const float* __restrict rx = b.rx.data(); const float* __restrict ry = b.ry.data(); const float* __restrict rz = b.rz.data();
-    const float* __restrict u0 = b.u_pos0.data(); const float* __restrict u1 = b.u_pos1.data();
-    const float* __restrict ax = b.ax.data(); const float* __restrict ay = b.ay.data(); const float* __restrict az = b.az.data();
-    const float* __restrict bx = b.bx.data(); const float* __restrict by = b.by.data(); const float* __restrict bz = b.bz.data();
-    const float* __restrict cx = b.cx.data(); const float* __restrict cy = b.cy.data(); const float* __restrict cz = b.cz.data();
-    const float* __restrict nx = b.nx.data(); const float* __restrict ny = b.ny.data(); const float* __restrict nz = b.nz.data();
+    const float* __restrict rx = b.rx.data();
+    const float* __restrict ry = b.ry.data();
+    const float* __restrict rz = b.rz.data();
+    const float* __restrict u0 = b.u_pos0.data();
+    const float* __restrict u1 = b.u_pos1.data();
+    const float* __restrict ax = b.ax.data();
+    const float* __restrict ay = b.ay.data();
+    const float* __restrict az = b.az.data();
+    const float* __restrict bx = b.bx.data();
+    const float* __restrict by = b.by.data();
+    const float* __restrict bz = b.bz.data();
+    const float* __restrict cx = b.cx.data();
+    const float* __restrict cy = b.cy.data();
+    const float* __restrict cz = b.cz.data();
+    const float* __restrict nx = b.nx.data();
+    const float* __restrict ny = b.ny.data();
+    const float* __restrict nz = b.nz.data();
     const float* __restrict pdf_area = b.pdf_area.data();
-    float* __restrict px = b.px.data(); float* __restrict py = b.py.data(); float* __restrict pz = b.pz.data();
-    float* __restrict wx = b.wx.data(); float* __restrict wy = b.wy.data(); float* __restrict wz = b.wz.data();
-    float* __restrict dist = b.dist.data(); float* __restrict pdf = b.pdf.data();
+    float* __restrict px = b.px.data();
+    float* __restrict py = b.py.data();
+    float* __restrict pz = b.pz.data();
+    float* __restrict wx = b.wx.data();
+    float* __restrict wy = b.wy.data();
+    float* __restrict wz = b.wz.data();
+    float* __restrict dist = b.dist.data();
+    float* __restrict pdf = b.pdf.data();
     // The arrays never overlap (restrict on locals is not enough for GCC's vectoriser).
 #pragma GCC ivdep
     for (size_t k = 0; k < n; ++k) {
@@ -103,8 +121,12 @@ void triangle_light_geometry(LightBatch& b, size_t n) {
         const float ix = dx * inv, iy = dy * inv, iz = dz * inv;
         const float cos_l = -(ix * nx[k] + iy * ny[k] + iz * nz[k]);
         const float ok = float(dist2 > 0.f) * float(cos_l > 0.f);
-        px[k] = qx; py[k] = qy; pz[k] = qz;
-        wx[k] = ix; wy[k] = iy; wz[k] = iz;
+        px[k] = qx;
+        py[k] = qy;
+        pz[k] = qz;
+        wx[k] = ix;
+        wy[k] = iy;
+        wz[k] = iz;
         dist[k] = d;
         pdf[k] = ok * (pdf_area[k] * dist2 / (ok * cos_l + (1.f - ok)));
     }
@@ -112,7 +134,8 @@ void triangle_light_geometry(LightBatch& b, size_t n) {
 
 }  // namespace
 
-void LightSampler::sample_batch(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, size_t n, LightBatch& b) const {
+void LightSampler::sample_batch(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, size_t n,
+                                LightBatch& b) const {
     // Choices (searches) one entry at a time; the chosen triangle's corners go to the arrays.
     for (size_t k = 0; k < n; ++k) {
         float u_tri;
@@ -126,10 +149,18 @@ void LightSampler::sample_batch(const std::vector<Emitter>& emitters, const std:
         const uint32_t* idx = &s.mesh.indices[3 * t];
         const Vec3f &p0 = s.mesh.positions[idx[0]], &p1 = s.mesh.positions[idx[1]], &p2 = s.mesh.positions[idx[2]];
         const Vec3f& nf = s.face_normal(t);
-        b.ax[k] = p0.x(); b.ay[k] = p0.y(); b.az[k] = p0.z();
-        b.bx[k] = p1.x(); b.by[k] = p1.y(); b.bz[k] = p1.z();
-        b.cx[k] = p2.x(); b.cy[k] = p2.y(); b.cz[k] = p2.z();
-        b.nx[k] = nf.x(); b.ny[k] = nf.y(); b.nz[k] = nf.z();
+        b.ax[k] = p0.x();
+        b.ay[k] = p0.y();
+        b.az[k] = p0.z();
+        b.bx[k] = p1.x();
+        b.by[k] = p1.y();
+        b.bz[k] = p1.z();
+        b.cx[k] = p2.x();
+        b.cy[k] = p2.y();
+        b.cz[k] = p2.z();
+        b.nx[k] = nf.x();
+        b.ny[k] = nf.y();
+        b.nz[k] = nf.z();
         b.pdf_area[k] = 1.f / s.area();
     }
     triangle_light_geometry(b, n);
@@ -138,7 +169,8 @@ void LightSampler::sample_batch(const std::vector<Emitter>& emitters, const std:
             b.pdf[k] *= m_pmf[b.emitter[k]];
             continue;
         }
-        b.set(k, sample(emitters, shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]), b.u_choice[k], Vec2f(b.u_pos0[k], b.u_pos1[k])));
+        b.set(k, sample(emitters, shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]), b.u_choice[k],
+                        Vec2f(b.u_pos0[k], b.u_pos1[k])));
     }
 }
 

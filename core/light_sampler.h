@@ -14,7 +14,8 @@ struct LightBatch;
 class LightSampler {
 public:
     /// scene_radius: bounding-sphere radius, used to weigh the environment against area lights.
-    void build(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, LightSampling mode, float scene_radius);
+    void build(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, LightSampling mode,
+               float scene_radius);
     bool empty() const { return m_pmf.empty(); }
     float pmf(int emitter) const { return m_pmf[emitter]; }
     /// Picks an emitter with u in [0,1); u_reuse gets the rescaled remainder for further use.
@@ -27,7 +28,8 @@ public:
     /// one by one, then the geometry (barycentric square root, direction, distance, pdf) in a
     /// loop the compiler evaluates 4-8 wide. Environment lights and emitters with interpolated
     /// normals fall back to sample(). tests/integrators/test_lights_camera.cpp compares them.
-    void sample_batch(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, size_t n, LightBatch& batch) const;
+    void sample_batch(const std::vector<Emitter>& emitters, const std::vector<Shape>& shapes, size_t n,
+                      LightBatch& batch) const;
 
 private:
     std::vector<float> m_pmf, m_cdf;
@@ -44,9 +46,15 @@ struct LightBatch {
     std::vector<uint8_t> scalar;  ///< 1: filled by sample() (environment, interpolated normals)
     void resize(size_t n);
     void set(size_t k, const LightSample& ls) {
-        px[k] = ls.p.x(); py[k] = ls.p.y(); pz[k] = ls.p.z();
-        nx[k] = ls.n.x(); ny[k] = ls.n.y(); nz[k] = ls.n.z();
-        wx[k] = ls.wi.x(); wy[k] = ls.wi.y(); wz[k] = ls.wi.z();
+        px[k] = ls.p.x();
+        py[k] = ls.p.y();
+        pz[k] = ls.p.z();
+        nx[k] = ls.n.x();
+        ny[k] = ls.n.y();
+        nz[k] = ls.n.z();
+        wx[k] = ls.wi.x();
+        wy[k] = ls.wi.y();
+        wz[k] = ls.wi.z();
         dist[k] = ls.dist;
         pdf[k] = ls.pdf;
         emitter[k] = ls.emitter;

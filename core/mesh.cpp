@@ -38,16 +38,15 @@ void validate_mesh(TriangleMesh& mesh, const std::string& file, const std::strin
     auto fail = [&](const std::string& msg) { throw SceneError(file, field, msg); };
     const size_t nv = mesh.positions.size();
     if (!mesh.normals.empty() && mesh.normals.size() != nv)
-        fail("mesh has " + std::to_string(mesh.normals.size()) + " normals but " + std::to_string(nv) +
-             " positions");
+        fail("mesh has " + std::to_string(mesh.normals.size()) + " normals but " + std::to_string(nv) + " positions");
     if (!mesh.uvs.empty() && mesh.uvs.size() != nv)
         fail("mesh has " + std::to_string(mesh.uvs.size()) + " uvs but " + std::to_string(nv) + " positions");
     if (mesh.indices.size() % 3 != 0)
         fail("index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
 
     for (size_t i = 0; i < nv; ++i)
-        if (!mesh.positions[i].allFinite()) fail("vertex " + std::to_string(i) + " has non-finite position " +
-                                                 vec_str(mesh.positions[i]));
+        if (!mesh.positions[i].allFinite())
+            fail("vertex " + std::to_string(i) + " has non-finite position " + vec_str(mesh.positions[i]));
     for (size_t i = 0; i < mesh.normals.size(); ++i) {
         Vec3f& n = mesh.normals[i];
         if (!n.allFinite()) fail("vertex " + std::to_string(i) + " has non-finite normal " + vec_str(n));
@@ -110,7 +109,8 @@ void compute_vertex_normals(TriangleMesh& mesh) {
     }
     bool planar = true;
     for (size_t t = 0; t < nt && planar; ++t)
-        for (int k = 0; k < 3; ++k) planar = planar && sum[mesh.indices[3 * t + k]].normalized().dot(face[t]) > 1.f - 1e-6f;
+        for (int k = 0; k < 3; ++k)
+            planar = planar && sum[mesh.indices[3 * t + k]].normalized().dot(face[t]) > 1.f - 1e-6f;
     if (planar) return;
     mesh.normals.resize(sum.size());
     for (size_t v = 0; v < sum.size(); ++v) {

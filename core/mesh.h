@@ -11,9 +11,9 @@ namespace lpt {
 
 struct TriangleMesh {
     std::vector<Vec3f> positions;
-    std::vector<Vec3f> normals;    ///< per vertex, empty if none (then face normals are used)
-    std::vector<Vec2f> uvs;        ///< per vertex, empty if none
-    std::vector<uint32_t> indices; ///< 3 per triangle
+    std::vector<Vec3f> normals;     ///< per vertex, empty if none (then face normals are used)
+    std::vector<Vec2f> uvs;         ///< per vertex, empty if none
+    std::vector<uint32_t> indices;  ///< 3 per triangle
     size_t triangle_count() const { return indices.size() / 3; }
     void transform(const Transform& world_from_object);
 };
@@ -49,8 +49,8 @@ TriangleMesh load_gltf(const std::string& path);
 TriangleMesh load_mesh_file(const std::string& path, bool flip_v = false, bool drop_degenerate = false);
 
 /// Analytic shapes, tessellated in object space (Mitsuba's canonical forms).
-TriangleMesh make_rectangle();                 ///< [-1,1]^2 at z=0, normal +z, uv in [0,1]^2
-TriangleMesh make_cube();                      ///< [-1,1]^3, outward normals, flat faces
+TriangleMesh make_rectangle();                                 ///< [-1,1]^2 at z=0, normal +z, uv in [0,1]^2
+TriangleMesh make_cube();                                      ///< [-1,1]^3, outward normals, flat faces
 TriangleMesh make_sphere(int rings = 64, int segments = 128);  ///< unit sphere, smooth normals
 
 }  // namespace lpt

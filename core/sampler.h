@@ -91,7 +91,9 @@ struct BitMatrixTable {
                 t[b][e] = x;
             }
     }
-    constexpr uint32_t operator()(uint32_t v) const { return t[0][v & 0xffu] ^ t[1][(v >> 8) & 0xffu] ^ t[2][(v >> 16) & 0xffu] ^ t[3][v >> 24]; }
+    constexpr uint32_t operator()(uint32_t v) const {
+        return t[0][v & 0xffu] ^ t[1][(v >> 8) & 0xffu] ^ t[2][(v >> 16) & 0xffu] ^ t[3][v >> 24];
+    }
 };
 
 constexpr uint32_t sobol_direction1(int k) {  // v_k of dimension 1
@@ -107,7 +109,8 @@ constexpr uint32_t reverse_bits32_constexpr(uint32_t x) {
 /// sobol_dimension1 itself, and the same map between bit-reversed words: reversed(sobol_1(reversed(z))),
 /// which lets the sampler stay in bit-reversed order between its two scrambles.
 inline constexpr BitMatrixTable kSobolDimension1{[](int k) { return sobol_direction1(k); }};
-inline constexpr BitMatrixTable kSobolDimension1Reversed{[](int k) { return reverse_bits32_constexpr(sobol_direction1(31 - k)); }};
+inline constexpr BitMatrixTable kSobolDimension1Reversed{
+    [](int k) { return reverse_bits32_constexpr(sobol_direction1(31 - k)); }};
 
 inline uint32_t sobol_dimension1(uint32_t index) { return kSobolDimension1(index); }
 
@@ -139,7 +142,8 @@ struct SobolPairPoint {
     uint64_t h;
     uint32_t shuffled_reversed;
     SobolPairPoint(uint64_t pixel_key, uint32_t pair, uint32_t reversed_index)
-        : h(mix64(pixel_key ^ (uint64_t(pair) * 0xd1b54a32d192ed03ULL))), shuffled_reversed(lk_hash(reversed_index, uint32_t(h))) {}
+        : h(mix64(pixel_key ^ (uint64_t(pair) * 0xd1b54a32d192ed03ULL))),
+          shuffled_reversed(lk_hash(reversed_index, uint32_t(h))) {}
     float coordinate(uint32_t c) const {
         const uint32_t z = c == 0 ? reverse_bits32(shuffled_reversed) : kSobolDimension1Reversed(shuffled_reversed);
         const uint32_t seed = uint32_t(h >> 32) ^ (c ? 0x9e3779b9u : 0u);
@@ -162,9 +166,12 @@ struct SampleStream {
     uint32_t reversed_index = 0;  ///< Sobol: reverse_bits32(index), shared by every dimension
     SamplerKind kind = SamplerKind::Independent;
     SampleStream(uint64_t seed, uint32_t pixel, uint32_t sample_index, SamplerKind k = SamplerKind::Independent)
-        : SampleStream(k == SamplerKind::Sobol ? sobol_pixel_key(seed, pixel) : sample_key(seed, pixel, sample_index), sample_index, k) {}
+        : SampleStream(k == SamplerKind::Sobol ? sobol_pixel_key(seed, pixel) : sample_key(seed, pixel, sample_index),
+                       sample_index, k) {}
     /// From a key hashed earlier (the tracer keeps one per path instead of rehashing per stage).
-    static SampleStream from_key(uint64_t key, uint32_t sample_index, SamplerKind k) { return SampleStream(key, sample_index, k); }
+    static SampleStream from_key(uint64_t key, uint32_t sample_index, SamplerKind k) {
+        return SampleStream(key, sample_index, k);
+    }
     float get(uint32_t dimension) const {
         if (kind != SamplerKind::Sobol) return sample_from_key(key, dimension);
         const DimensionPair d = dimension_pair(dimension);
@@ -184,21 +191,27 @@ struct SampleStream {
     }
 
 private:
-    SampleStream(uint64_t k, uint32_t i, SamplerKind s) : key(k), index(i), reversed_index(s == SamplerKind::Sobol ? reverse_bits32(i) : 0), kind(s) {}
+    SampleStream(uint64_t k, uint32_t i, SamplerKind s)
+        : key(k), index(i), reversed_index(s == SamplerKind::Sobol ? reverse_bits32(i) : 0), kind(s) {}
 };
 
 /// get2's precondition, checked at compile time for the pairs the tracer draws together.
-static_assert(dimension_pair(dim::kFilter).coordinate == 0 && dimension_pair(dim::kFilter + 1).pair == dimension_pair(dim::kFilter).pair);
+static_assert(dimension_pair(dim::kFilter).coordinate == 0 &&
+              dimension_pair(dim::kFilter + 1).pair == dimension_pair(dim::kFilter).pair);
 static_assert(dimension_pair(dim::bounce(3, dim::kLightPos)).coordinate == 0 &&
-              dimension_pair(dim::bounce(3, dim::kLightPos + 1)).pair == dimension_pair(dim::bounce(3, dim::kLightPos)).pair);
+              dimension_pair(dim::bounce(3, dim::kLightPos + 1)).pair ==
+                  dimension_pair(dim::bounce(3, dim::kLightPos)).pair);
 static_assert(dimension_pair(dim::bounce(3, dim::kBsdfDir)).coordinate == 0 &&
-              dimension_pair(dim::bounce(3, dim::kBsdfDir + 1)).pair == dimension_pair(dim::bounce(3, dim::kBsdfDir)).pair);
+              dimension_pair(dim::bounce(3, dim::kBsdfDir + 1)).pair ==
+                  dimension_pair(dim::bounce(3, dim::kBsdfDir)).pair);
 
 /// What regenerates a render's random numbers: its seed and sampler kind (path replay keeps it).
 struct SamplerId {
     uint64_t seed = 0;
     SamplerKind kind = SamplerKind::Sobol;
-    SampleStream stream(uint32_t pixel, uint32_t sample_index) const { return SampleStream(seed, pixel, sample_index, kind); }
+    SampleStream stream(uint32_t pixel, uint32_t sample_index) const {
+        return SampleStream(seed, pixel, sample_index, kind);
+    }
 };
 
 /// "independent" / "sobol" (the CLI's and the scene files' spelling).

@@ -9,7 +9,9 @@ namespace lpt {
 RTCDevice embree_device() {
     static RTCDevice device = [] {
         RTCDevice d = rtcNewDevice(nullptr);
-        if (!d) throw std::runtime_error("Embree: cannot create device (error " + std::to_string(rtcGetDeviceError(nullptr)) + ")");
+        if (!d)
+            throw std::runtime_error("Embree: cannot create device (error " +
+                                     std::to_string(rtcGetDeviceError(nullptr)) + ")");
         return d;
     }();
     return device;
@@ -55,7 +57,8 @@ void Scene::build() {
         const Shape& s = shapes[i];
         if (s.material < 0 || s.material >= int(materials.size()))
             throw SceneError(file, "shapes." + s.id + ".material", "shape has no valid material");
-        if (s.emitter >= int(emitters.size())) throw SceneError(file, "shapes." + s.id + ".emitter", "bad emitter index");
+        if (s.emitter >= int(emitters.size()))
+            throw SceneError(file, "shapes." + s.id + ".emitter", "bad emitter index");
     }
     for (auto& s : shapes) s.prepare();
 
@@ -68,14 +71,16 @@ void Scene::build() {
         const TriangleMesh& m = shapes[i].mesh;
         RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
         // Embree reads vertex buffers with 16-byte loads: pad by one float.
-        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.positions.size()));
+        float* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                               3 * sizeof(float), m.positions.size()));
         for (size_t k = 0; k < m.positions.size(); ++k) {
             v[3 * k] = m.positions[k].x();
             v[3 * k + 1] = m.positions[k].y();
             v[3 * k + 2] = m.positions[k].z();
             box.extend(m.positions[k]);
         }
-        uint32_t* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
+        uint32_t* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                       3 * sizeof(uint32_t), m.triangle_count()));
         std::copy(m.indices.begin(), m.indices.end(), idx);
         rtcCommitGeometry(g);
         rtcAttachGeometryByID(m_rtc, g, unsigned(i));
@@ -93,8 +98,12 @@ SurfaceInteraction Scene::intersect(const Ray& ray) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    rh.ray.org_x = ray.o.x(); rh.ray.org_y = ray.o.y(); rh.ray.org_z = ray.o.z();
-    rh.ray.dir_x = ray.d.x(); rh.ray.dir_y = ray.d.y(); rh.ray.dir_z = ray.d.z();
+    rh.ray.org_x = ray.o.x();
+    rh.ray.org_y = ray.o.y();
+    rh.ray.org_z = ray.o.z();
+    rh.ray.dir_x = ray.d.x();
+    rh.ray.dir_y = ray.d.y();
+    rh.ray.dir_z = ray.d.z();
     rh.ray.tnear = ray.tmin;
     rh.ray.tfar = ray.tmax;
     rh.ray.time = 0.f;
@@ -114,8 +123,12 @@ bool Scene::occluded(const Vec3f& o, const Vec3f& d, float tmax) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
-    r.org_x = o.x(); r.org_y = o.y(); r.org_z = o.z();
-    r.dir_x = d.x(); r.dir_y = d.y(); r.dir_z = d.z();
+    r.org_x = o.x();
+    r.org_y = o.y();
+    r.org_z = o.z();
+    r.dir_x = d.x();
+    r.dir_y = d.y();
+    r.dir_z = d.z();
     r.tnear = 0.f;
     r.tfar = tmax;
     r.time = 0.f;

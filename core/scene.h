@@ -16,9 +16,9 @@
 namespace lpt {
 
 struct IntegratorSettings {
-    int max_depth = 8;   ///< longest path in segments, Mitsuba's semantics; -1 = unbounded
-    int rr_depth = 5;    ///< Russian roulette from this depth on
-    int spp = 16;        ///< default samples per pixel
+    int max_depth = 8;                         ///< longest path in segments, Mitsuba's semantics; -1 = unbounded
+    int rr_depth = 5;                          ///< Russian roulette from this depth on
+    int spp = 16;                              ///< default samples per pixel
     SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
     LightSampling light_sampling = LightSampling::Power;
 };
@@ -32,11 +32,11 @@ public:
     Scene(const Scene&) = delete;
     Scene& operator=(const Scene&) = delete;
 
-    std::string file;            ///< where it was loaded from (error messages)
+    std::string file;  ///< where it was loaded from (error messages)
     std::vector<Shape> shapes;
     std::vector<Props> materials;
     std::vector<Emitter> emitters;
-    int environment = -1;        ///< index into emitters of the constant emitter, or -1
+    int environment = -1;  ///< index into emitters of the constant emitter, or -1
     Camera camera;
     IntegratorSettings integrator;
     LightSampler lights;

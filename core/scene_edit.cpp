@@ -20,14 +20,17 @@ namespace {
 
 struct Parser {
     std::string file;
-    [[noreturn]] void fail(const std::string& field, const std::string& msg) const { throw SceneError(file, field, msg); }
+    [[noreturn]] void fail(const std::string& field, const std::string& msg) const {
+        throw SceneError(file, field, msg);
+    }
 
     Vec3f vec(const json& j, const std::string& field, bool scalar_ok) const {
         if (j.is_number()) {
             if (!scalar_ok) fail(field, "expected [x, y, z]");
             return Vec3f::Constant(j.get<float>());
         }
-        if (!j.is_array() || j.size() != 3) fail(field, scalar_ok ? "expected a number or [x, y, z]" : "expected [x, y, z]");
+        if (!j.is_array() || j.size() != 3)
+            fail(field, scalar_ok ? "expected a number or [x, y, z]" : "expected [x, y, z]");
         Vec3f v;
         for (int i = 0; i < 3; ++i) {
             if (!j[i].is_number()) fail(field, "expected numbers");
@@ -70,6 +73,68 @@ Eigen::AlignedBox3f bounds(const TriangleMesh& m) {
     return b;
 }
 
+CameraEdit read_camera_edit(const Parser& p, const json& c, const Scene& scene) {
+    CameraEdit cam;
+    if (c.contains("orbit")) {
+        const json& o = c["orbit"];
+        cam.kind = CameraEdit::Kind::Orbit;
+        cam.azimuth = o.contains("azimuth") ? p.track(o["azimuth"], "camera.orbit.azimuth", Parser::Kind::Scalar)
+                                            : Track{{Vec3f::Zero()}};
+        cam.elevation = o.contains("elevation")
+                            ? p.track(o["elevation"], "camera.orbit.elevation", Parser::Kind::Scalar)
+                            : Track{{Vec3f::Zero()}};
+        cam.pivot = o.contains("pivot") ? p.vec(o["pivot"], "camera.orbit.pivot", false) : scene.bounds_center();
+        if (o.contains("up")) cam.up = p.vec(o["up"], "camera.orbit.up", false).normalized();
+    } else if (c.contains("lookat")) {
+        const json& l = c["lookat"];
+        cam.kind = CameraEdit::Kind::LookAt;
+        for (const char* k : {"origin", "target", "up"})
+            if (!l.contains(k)) p.fail(std::string("camera.lookat.") + k, "missing");
+        cam.origin = p.track(l["origin"], "camera.lookat.origin", Parser::Kind::Vector);
+        cam.target = p.track(l["target"], "camera.lookat.target", Parser::Kind::Vector);
+        cam.look_up = p.track(l["up"], "camera.lookat.up", Parser::Kind::Vector);
+    } else {
+        p.fail("camera", "expected {\"orbit\": ...} or {\"lookat\": ...}");
+    }
+    return cam;
+}
+
+std::vector<ShapeEdit> read_shape_edits(const Parser& p, const json& list, const Scene& scene) {
+    if (!list.is_array()) p.fail("shapes", "expected an array");
+    std::vector<ShapeEdit> out;
+    for (size_t i = 0; i < list.size(); ++i) {
+        const json& s = list[i];
+        const std::string f = "shapes[" + std::to_string(i) + "]";
+        if (!s.is_object() || !s.contains("id") || !s["id"].is_string()) p.fail(f + ".id", "missing shape id");
+        ShapeEdit e;
+        e.id = s["id"].get<std::string>();
+        e.shape = scene.find_shape(e.id);
+        if (e.shape < 0) p.fail(f + ".id", "no shape '" + e.id + "' in the scene");
+        e.translate = s.contains("translate") ? p.track(s["translate"], f + ".translate", Parser::Kind::Vector)
+                                              : Track{{Vec3f::Zero()}};
+        e.scale = s.contains("scale") ? p.track(s["scale"], f + ".scale", Parser::Kind::Scale) : Track{{Vec3f::Ones()}};
+        e.rotate_angle = Track{{Vec3f::Zero()}};
+        if (s.contains("rotate")) {
+            const json& r = s["rotate"];
+            if (!r.is_object() || !r.contains("angle"))
+                p.fail(f + ".rotate", "expected {\"axis\": [x,y,z], \"angle\": degrees or keyframes}");
+            if (r.contains("axis")) e.rotate_axis = p.vec(r["axis"], f + ".rotate.axis", false);
+            if (e.rotate_axis.norm() == 0.f) p.fail(f + ".rotate.axis", "zero axis");
+            e.rotate_axis.normalize();
+            e.rotate_angle = p.track(r["angle"], f + ".rotate.angle", Parser::Kind::Scalar);
+        }
+        if (s.contains("pivot")) {
+            e.pivot = p.track(s["pivot"], f + ".pivot", Parser::Kind::Vector);
+            e.has_pivot = true;
+        }
+        for (const auto& [key, v] : s.items())
+            if (key != "id" && key != "translate" && key != "scale" && key != "rotate" && key != "pivot")
+                p.fail(f + "." + key, "unknown key (known: id, translate, rotate, scale, pivot)");
+        out.push_back(e);
+    }
+    return out;
+}
+
 }  // namespace
 
 EditSequence load_edits(const std::string& path, const Scene& scene) {
@@ -85,73 +150,27 @@ EditSequence load_edits(const std::string& path, const Scene& scene) {
     if (!j.is_object()) p.fail("", "top level must be an object");
     EditSequence seq;
     for (const auto& [key, v] : j.items())
-        if (key != "frames" && key != "camera" && key != "shapes") p.fail(key, "unknown key (known: frames, camera, shapes)");
+        if (key != "frames" && key != "camera" && key != "shapes")
+            p.fail(key, "unknown key (known: frames, camera, shapes)");
     if (j.contains("frames")) {
-        if (!j["frames"].is_number_integer() || j["frames"].get<int>() < 1) p.fail("frames", "expected an integer >= 1");
+        if (!j["frames"].is_number_integer() || j["frames"].get<int>() < 1)
+            p.fail("frames", "expected an integer >= 1");
         seq.frames = j["frames"].get<int>();
     }
-    if (j.contains("camera")) {
-        const json& c = j["camera"];
-        if (c.contains("orbit")) {
-            const json& o = c["orbit"];
-            seq.camera.kind = CameraEdit::Kind::Orbit;
-            seq.camera.azimuth = o.contains("azimuth") ? p.track(o["azimuth"], "camera.orbit.azimuth", Parser::Kind::Scalar) : Track{{Vec3f::Zero()}};
-            seq.camera.elevation = o.contains("elevation") ? p.track(o["elevation"], "camera.orbit.elevation", Parser::Kind::Scalar) : Track{{Vec3f::Zero()}};
-            seq.camera.pivot = o.contains("pivot") ? p.vec(o["pivot"], "camera.orbit.pivot", false) : scene.bounds_center();
-            if (o.contains("up")) seq.camera.up = p.vec(o["up"], "camera.orbit.up", false).normalized();
-        } else if (c.contains("lookat")) {
-            const json& l = c["lookat"];
-            seq.camera.kind = CameraEdit::Kind::LookAt;
-            for (const char* k : {"origin", "target", "up"})
-                if (!l.contains(k)) p.fail(std::string("camera.lookat.") + k, "missing");
-            seq.camera.origin = p.track(l["origin"], "camera.lookat.origin", Parser::Kind::Vector);
-            seq.camera.target = p.track(l["target"], "camera.lookat.target", Parser::Kind::Vector);
-            seq.camera.look_up = p.track(l["up"], "camera.lookat.up", Parser::Kind::Vector);
-        } else {
-            p.fail("camera", "expected {\"orbit\": ...} or {\"lookat\": ...}");
-        }
-    }
-    if (j.contains("shapes")) {
-        if (!j["shapes"].is_array()) p.fail("shapes", "expected an array");
-        for (size_t i = 0; i < j["shapes"].size(); ++i) {
-            const json& s = j["shapes"][i];
-            const std::string f = "shapes[" + std::to_string(i) + "]";
-            if (!s.is_object() || !s.contains("id") || !s["id"].is_string()) p.fail(f + ".id", "missing shape id");
-            ShapeEdit e;
-            e.id = s["id"].get<std::string>();
-            e.shape = scene.find_shape(e.id);
-            if (e.shape < 0) p.fail(f + ".id", "no shape '" + e.id + "' in the scene");
-            e.translate = s.contains("translate") ? p.track(s["translate"], f + ".translate", Parser::Kind::Vector) : Track{{Vec3f::Zero()}};
-            e.scale = s.contains("scale") ? p.track(s["scale"], f + ".scale", Parser::Kind::Scale) : Track{{Vec3f::Ones()}};
-            e.rotate_angle = Track{{Vec3f::Zero()}};
-            if (s.contains("rotate")) {
-                const json& r = s["rotate"];
-                if (!r.is_object() || !r.contains("angle")) p.fail(f + ".rotate", "expected {\"axis\": [x,y,z], \"angle\": degrees or keyframes}");
-                if (r.contains("axis")) e.rotate_axis = p.vec(r["axis"], f + ".rotate.axis", false);
-                if (e.rotate_axis.norm() == 0.f) p.fail(f + ".rotate.axis", "zero axis");
-                e.rotate_axis.normalize();
-                e.rotate_angle = p.track(r["angle"], f + ".rotate.angle", Parser::Kind::Scalar);
-            }
-            if (s.contains("pivot")) {
-                e.pivot = p.track(s["pivot"], f + ".pivot", Parser::Kind::Vector);
-                e.has_pivot = true;
-            }
-            for (const auto& [key, v] : s.items())
-                if (key != "id" && key != "translate" && key != "scale" && key != "rotate" && key != "pivot")
-                    p.fail(f + "." + key, "unknown key (known: id, translate, rotate, scale, pivot)");
-            seq.shapes.push_back(e);
-        }
-    }
+    if (j.contains("camera")) seq.camera = read_camera_edit(p, j["camera"], scene);
+    if (j.contains("shapes")) seq.shapes = read_shape_edits(p, j["shapes"], scene);
     return seq;
 }
 
-void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original, const Camera& original_camera, Scene& scene) {
+void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original,
+                 const Camera& original_camera, Scene& scene) {
     for (size_t i = 0; i < scene.shapes.size(); ++i) scene.shapes[i].mesh = original[i];
     for (const ShapeEdit& e : edits.shapes) {
         TriangleMesh& m = scene.shapes[e.shape].mesh;
         Vec3f pivot = e.has_pivot ? e.pivot.at(t) : bounds(original[e.shape]).center();
-        Transform xf = Transform::translate(e.translate.at(t)) * Transform::translate(pivot) * Transform::rotate(e.rotate_axis, e.rotate_angle.at(t).x()) *
-                       Transform::scale(e.scale.at(t)) * Transform::translate(-pivot);
+        Transform xf = Transform::translate(e.translate.at(t)) * Transform::translate(pivot) *
+                       Transform::rotate(e.rotate_axis, e.rotate_angle.at(t).x()) * Transform::scale(e.scale.at(t)) *
+                       Transform::translate(-pivot);
         m.transform(xf);
     }
     scene.camera = original_camera;

@@ -19,15 +19,15 @@ struct ShapeEdit {
     int shape = -1;
     Track translate, scale, rotate_angle;  ///< rotate_angle.x() holds degrees
     Vec3f rotate_axis = Vec3f::UnitY();
-    Track pivot;                            ///< rotation/scaling centre (default: the shape's bbox centre)
+    Track pivot;  ///< rotation/scaling centre (default: the shape's bbox centre)
     bool has_pivot = false;
 };
 
 struct CameraEdit {
     enum class Kind { None, Orbit, LookAt } kind = Kind::None;
-    Track azimuth, elevation;               ///< degrees (x component), for Orbit
+    Track azimuth, elevation;  ///< degrees (x component), for Orbit
     Vec3f pivot = Vec3f::Zero(), up = Vec3f::UnitY();
-    Track origin, target, look_up;          ///< for LookAt
+    Track origin, target, look_up;  ///< for LookAt
 };
 
 struct EditSequence {
@@ -41,6 +41,7 @@ EditSequence load_edits(const std::string& path, const Scene& scene);
 
 /// Applies the sequence at time t to `scene`, whose shapes' meshes are reset from `original`
 /// first (so frames do not accumulate), then rebuilds the BVH and light sampler.
-void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original, const Camera& original_camera, Scene& scene);
+void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original,
+                 const Camera& original_camera, Scene& scene);
 
 }  // namespace lpt

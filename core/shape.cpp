@@ -19,7 +19,9 @@ void Shape::prepare() {
     m_face_normals.resize(n);
     for (size_t t = 0; t < n; ++t) {
         const uint32_t* idx = &mesh.indices[3 * t];
-        m_face_normals[t] = (mesh.positions[idx[1]] - mesh.positions[idx[0]]).cross(mesh.positions[idx[2]] - mesh.positions[idx[0]]).normalized();
+        m_face_normals[t] = (mesh.positions[idx[1]] - mesh.positions[idx[0]])
+                                .cross(mesh.positions[idx[2]] - mesh.positions[idx[0]])
+                                .normalized();
     }
     double sum = 0.0;  // double: 270k-triangle meshes lose float precision in the running sum
     for (size_t t = 0; t < n; ++t) {

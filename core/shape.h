@@ -21,8 +21,8 @@ struct SurfaceInteraction {
 };
 
 struct PositionSample {
-    Vec3f p, n;        ///< point and its (shading) normal: the side an area light emits to
-    float pdf_area;    ///< density per unit area
+    Vec3f p, n;      ///< point and its (shading) normal: the side an area light emits to
+    float pdf_area;  ///< density per unit area
 };
 
 class Shape {

@@ -16,7 +16,8 @@ bool is_mesh_file(const std::string& type) { return type == "obj" || type == "pl
 TriangleMesh load_mesh(const Props& p, const ShapeDefaults& defaults) {
     const std::string filename = p.get_string("filename");
     try {
-        return load_mesh_file(filename, p.get_bool("flip_tex_coords", defaults.flip_tex_coords), defaults.drop_degenerate);
+        return load_mesh_file(filename, p.get_bool("flip_tex_coords", defaults.flip_tex_coords),
+                              defaults.drop_degenerate);
     } catch (const SceneError& e) {
         p.fail("filename", e.what());
     }
@@ -42,7 +43,8 @@ Shape make_shape_from_mesh(TriangleMesh object_mesh, const Props& p, const Shape
     if (p.get_bool("flip_normals", false)) flip_normals(shape.mesh);
     validate_mesh(shape.mesh, p.file, p.where, defaults.drop_degenerate);
     const bool from_file = is_mesh_file(p.type);
-    if (from_file && defaults.smooth_missing_normals && !shape.face_normals && shape.mesh.normals.empty()) compute_vertex_normals(shape.mesh);
+    if (from_file && defaults.smooth_missing_normals && !shape.face_normals && shape.mesh.normals.empty())
+        compute_vertex_normals(shape.mesh);
     return shape;
 }
 

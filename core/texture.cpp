@@ -34,9 +34,12 @@ std::shared_ptr<const BitmapData> decode(const std::string& path, bool raw) {
     const OIIO::ImageSpec& spec = in->spec();
     const int w = spec.width, h = spec.height, nc = spec.nchannels;
     if (w <= 0 || h <= 0 || spec.depth > 1) throw SceneError(path, "", "image is empty or not 2D");
-    if (nc < 1 || nc > 4) throw SceneError(path, "", "image has " + std::to_string(nc) + " channels (expected 1 to 4: Y, YA, RGB or RGBA)");
+    if (nc < 1 || nc > 4)
+        throw SceneError(path, "",
+                         "image has " + std::to_string(nc) + " channels (expected 1 to 4: Y, YA, RGB or RGBA)");
     const OIIO::TypeDesc::BASETYPE base = OIIO::TypeDesc::BASETYPE(spec.format.basetype);
-    const bool is_float = base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
+    const bool is_float =
+        base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
     const bool srgb = !is_float && !raw;  // Mitsuba 3: JPEG/PNG data is sRGB, EXR/HDR linear
 
     const size_t n = size_t(w) * size_t(h);
@@ -70,7 +73,9 @@ std::shared_ptr<const BitmapData> decode(const std::string& path, bool raw) {
         for (int c = 0; c < 3; ++c) {
             float v = p[grey ? 0 : c];
             if (!std::isfinite(v))
-                throw SceneError(path, "", "pixel (" + std::to_string(i % size_t(w)) + ", " + std::to_string(i / size_t(w)) + ") is not finite");
+                throw SceneError(path, "",
+                                 "pixel (" + std::to_string(i % size_t(w)) + ", " + std::to_string(i / size_t(w)) +
+                                     ") is not finite");
             out->rgb[3 * i + c] = v;
             sum[c] += v;
         }
@@ -108,17 +113,18 @@ std::shared_ptr<const BitmapData> cached_bitmap(const std::string& path, bool ra
 
 int64_t wrap_index(int64_t i, int64_t n, TextureWrap mode) {
     switch (mode) {
-    case TextureWrap::Clamp: return std::clamp<int64_t>(i, 0, n - 1);
-    case TextureWrap::Mirror: {  // period 2n: 0..n-1 then n-1..0
-        int64_t m = i % (2 * n);
-        if (m < 0) m += 2 * n;
-        return m < n ? m : 2 * n - 1 - m;
-    }
-    case TextureWrap::Repeat:
-    default: {
-        int64_t m = i % n;
-        return m < 0 ? m + n : m;
-    }
+        case TextureWrap::Clamp:
+            return std::clamp<int64_t>(i, 0, n - 1);
+        case TextureWrap::Mirror: {  // period 2n: 0..n-1 then n-1..0
+            int64_t m = i % (2 * n);
+            if (m < 0) m += 2 * n;
+            return m < n ? m : 2 * n - 1 - m;
+        }
+        case TextureWrap::Repeat:
+        default: {
+            int64_t m = i % n;
+            return m < 0 ? m + n : m;
+        }
     }
 }
 
@@ -126,7 +132,8 @@ int64_t wrap_index(int64_t i, int64_t n, TextureWrap mode) {
 /// (any index that far out wraps to an arbitrary but valid pixel, as in float arithmetic).
 /// Errors name the owner's field (`materials.wood.reflectance.filter_type`), whatever `where`
 /// the texture's own Props was given.
-[[noreturn]] void fail_texture_field(const Props& owner, const std::string& key, const std::string& sub, const std::string& msg) {
+[[noreturn]] void fail_texture_field(const Props& owner, const std::string& key, const std::string& sub,
+                                     const std::string& msg) {
     owner.fail(key + "." + sub, msg);
 }
 
@@ -135,7 +142,10 @@ int64_t floor_index(float x) { return int64_t(std::floor(std::clamp(x, -1e15f, 1
 }  // namespace
 
 Texture::Texture(std::shared_ptr<const BitmapData> bitmap, TextureFilter filter, TextureWrap wrap)
-    : m_constant(bitmap ? bitmap->mean : Eigen::Array3f::Zero()), m_bitmap(std::move(bitmap)), m_filter(filter), m_wrap(wrap) {}
+    : m_constant(bitmap ? bitmap->mean : Eigen::Array3f::Zero()),
+      m_bitmap(std::move(bitmap)),
+      m_filter(filter),
+      m_wrap(wrap) {}
 
 Texture Texture::load_bitmap(const std::string& path, bool raw, TextureFilter filter, TextureWrap wrap) {
     return Texture(cached_bitmap(path, raw), filter, wrap);
@@ -164,7 +174,8 @@ Texture texture_from_props(const Props& owner, const std::string& key, const Eig
     auto it = owner.values.find(key);
     if (it == owner.values.end()) return Texture(default_rgb);
     const PropValue& v = it->second;
-    if (std::holds_alternative<float>(v) || std::holds_alternative<Eigen::Array3f>(v)) return Texture(owner.get_rgb(key, default_rgb));
+    if (std::holds_alternative<float>(v) || std::holds_alternative<Eigen::Array3f>(v))
+        return Texture(owner.get_rgb(key, default_rgb));
     const auto* child = std::get_if<std::shared_ptr<Props>>(&v);
     if (!child || !*child) owner.fail(key, "expected an rgb triple, a number or a bitmap texture");
     const Props& t = **child;

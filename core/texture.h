@@ -45,8 +45,8 @@ public:
     /// (8/16-bit JPEG, PNG, ...) are sRGB-encoded and linearised by the exact sRGB EOTF unless
     /// raw; float and half images (EXR, HDR) are linear. Grey broadcasts to RGB; alpha is
     /// dropped (not multiplied in). Throws SceneError(path, ...) if it cannot be read.
-    static Texture load_bitmap(const std::string& path, bool raw = false, TextureFilter filter = TextureFilter::Bilinear,
-                               TextureWrap wrap = TextureWrap::Repeat);
+    static Texture load_bitmap(const std::string& path, bool raw = false,
+                               TextureFilter filter = TextureFilter::Bilinear, TextureWrap wrap = TextureWrap::Repeat);
 
     bool is_constant() const { return !m_bitmap; }
     Eigen::Array3f eval(const Vec2f& uv) const;

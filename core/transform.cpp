@@ -11,7 +11,9 @@ Transform Transform::translate(const Vec3f& t) {
 
 Transform Transform::scale(const Vec3f& s) {
     Eigen::Matrix4f m = Eigen::Matrix4f::Identity();
-    m(0, 0) = s.x(); m(1, 1) = s.y(); m(2, 2) = s.z();
+    m(0, 0) = s.x();
+    m(1, 1) = s.y();
+    m(2, 2) = s.z();
     return Transform(m);
 }
 

@@ -16,7 +16,8 @@ namespace lpt {
 /// such angles, and libm's sincosf was ~9% of a Cornell box render (docs/performance.md).
 inline void sincos_quarter_pi(float a, float& s, float& c) {
     const float a2 = a * a;
-    s = a * (1.f + a2 * (-1.f / 6.f + a2 * (1.f / 120.f + a2 * (-1.f / 5040.f + a2 * (1.f / 362880.f + a2 * (-1.f / 39916800.f))))));
+    s = a * (1.f + a2 * (-1.f / 6.f +
+                         a2 * (1.f / 120.f + a2 * (-1.f / 5040.f + a2 * (1.f / 362880.f + a2 * (-1.f / 39916800.f))))));
     c = 1.f + a2 * (-0.5f + a2 * (1.f / 24.f + a2 * (-1.f / 720.f + a2 * (1.f / 40320.f + a2 * (-1.f / 3628800.f)))));
 }
 

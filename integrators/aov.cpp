@@ -4,7 +4,8 @@
 
 namespace lpt {
 
-AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed, SamplerKind sampler) {
+AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed,
+                      SamplerKind sampler) {
     Camera camera = scene.camera.with_resolution(width, height);
     AovImages out;
     out.width = width;

@@ -19,28 +19,9 @@
 namespace lpt {
 
 namespace {
-bool g_sampler_overridden = false;
-SamplerKind g_sampler_override = SamplerKind::Sobol;
-}  // namespace
 
-void set_sampler_override(SamplerKind kind) {
-    g_sampler_overridden = true;
-    g_sampler_override = kind;
-}
-
-RenderOptions RenderOptions::from_scene(const Scene& scene) {
-    RenderOptions o;
-    o.spp = scene.integrator.spp;
-    o.max_depth = scene.integrator.max_depth;
-    o.rr_depth = scene.integrator.rr_depth;
-    o.sampler = g_sampler_overridden ? g_sampler_override : scene.integrator.sampler;
-    return o;
-}
-
-namespace {
-
-constexpr int kTile = 16;              // tile side in pixels: one task owns a tile's pixels
-constexpr size_t kWavefront = 4096;    // paths advanced together
+constexpr int kTile = 16;            // tile side in pixels: one task owns a tile's pixels
+constexpr size_t kWavefront = 4096;  // paths advanced together
 
 template <int N>
 struct Workspace {
@@ -59,16 +40,23 @@ class PathTracer {
 public:
     PathTracer(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& opt, const Camera& camera,
                const LatentTerms<N>* terms, PathObserver<N>* observer)
-        : m_scene(scene), m_spectra(spectra), m_opt(opt), m_camera(camera), m_obs(observer),
+        : m_scene(scene),
+          m_spectra(spectra),
+          m_opt(opt),
+          m_camera(camera),
+          m_obs(observer),
           m_latent(terms ? std::make_optional<LatentStage<N>>(*terms, observer) : std::nullopt),
-          m_emission(!terms || terms->emission), m_keep_zero(terms != nullptr) {
+          m_emission(!terms || terms->emission),
+          m_keep_zero(terms != nullptr) {
         m_lambertian.reserve(scene.shapes.size());
-        for (size_t s = 0; s < scene.shapes.size(); ++s) m_lambertian.push_back(spectra.bsdf_of(scene, int(s)).lambertian());
+        for (size_t s = 0; s < scene.shapes.size(); ++s)
+            m_lambertian.push_back(spectra.bsdf_of(scene, int(s)).lambertian());
     }
 
     /// Traces samples [s0, s0 + count) of every pixel in [x0,x1)×[y0,y1) and adds them to film.
     /// films[1], films[2] (Ĩa, Ĩc) are written only for latent terms.
-    void trace_tile(Workspace<N>& ws, Film<N>* const films[3], int tile, int x0, int y0, int x1, int y1, int s0, int count, RenderStats& st) const {
+    void trace_tile(Workspace<N>& ws, Film<N>* const films[3], int tile, int x0, int y0, int x1, int y1, int s0,
+                    int count, RenderStats& st) const {
         const int tile_pixels = (x1 - x0) * (y1 - y0);
         const size_t n = size_t(tile_pixels) * count;
         ws.paths.resize(n);
@@ -99,7 +87,8 @@ public:
     }
 
 private:
-    void generate_camera_rays(Workspace<N>& ws, int x0, int y0, int x1, int s0, int count, size_t n, RenderStats& st) const {
+    void generate_camera_rays(Workspace<N>& ws, int x0, int y0, int x1, int s0, int count, size_t n,
+                              RenderStats& st) const {
         PathState<N>& p = ws.paths;
         ws.queue[0].resize(n);
         // Pixel, key and filter randoms per path, then all camera rays at once (Camera::generate_rays)
@@ -122,7 +111,8 @@ private:
         RayArrays& rays = ws.rays[0];
         rays.resize_for_fill(n);
         m_camera.generate_rays(n, fx, fy, u0, u1, m_camera.tan_half_fov(),
-                               {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(), rays.dz.data(), rays.tnear.data(), rays.tfar.data()});
+                               {rays.ox.data(), rays.oy.data(), rays.oz.data(), rays.dx.data(), rays.dy.data(),
+                                rays.dz.data(), rays.tnear.data(), rays.tfar.data()});
         for (size_t k = 0; k < n; ++k) {
             p.beta[k].setOnes();
             p.radiance[k].setZero();
@@ -194,7 +184,8 @@ private:
             if (shape.emitter >= 0 && m_emission) {
                 Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
                 if (ne.dot(wi_world) > 0.f) {
-                    float light_pdf = m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
+                    float light_pdf =
+                        m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
                     float w = hit_weight(p, slot, light_pdf);
                     if (w > 0.f) {
                         p.radiance[slot] += emission_score(p.beta[slot], w, m_spectra.radiance[shape.emitter]);
@@ -226,29 +217,17 @@ private:
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
         const bool nee_on = m_emission && m_opt.strategy != LightStrategy::Bsdf && !m_scene.lights.empty();
-        // Every entry's light sample first, as a batch (core/light_sampler.h): per vertex it is a
-        // long dependent chain of square roots and divisions.
-        if (!m_scene.lights.empty()) {
-            LightBatch& lb = ws.lights;
-            lb.resize(sq.size());
-            for (size_t k = 0; k < sq.size(); ++k) {
-                const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler);
-                lb.rx[k] = sq.p[k].x(); lb.ry[k] = sq.p[k].y(); lb.rz[k] = sq.p[k].z();
-                lb.u_choice[k] = rng.get(dim::bounce(depth, dim::kLightChoice));
-                rng.get2(dim::bounce(depth, dim::kLightPos), lb.u_pos0[k], lb.u_pos1[k]);
-            }
-            m_scene.lights.sample_batch(m_scene.emitters, m_scene.shapes, sq.size(), lb);
-        }
+        if (!m_scene.lights.empty()) draw_light_samples(ws, depth);
         for (size_t k = 0; k < sq.size(); ++k) {
             const bool first = (sq.flags[k] & ShadeQueue::kFirst) != 0;
-            const bool nee = nee_on && (sq.flags[k] & ShadeQueue::kContinue) && !m_spectra.is_delta(m_scene, sq.shape[k]);
+            const bool nee =
+                nee_on && (sq.flags[k] & ShadeQueue::kContinue) && !m_spectra.is_delta(m_scene, sq.shape[k]);
             if (!nee && !first) continue;
             const uint32_t slot = sq.slot[k];
             Spectrum<N> occl = Spectrum<N>::Zero();
             if (first) occl = m_latent->occlusion(p, slot, sq.shape[k]);
             if (m_scene.lights.empty()) {  // no light: everything is in shadow
-                if (first) m_latent->gate(p, slot, occl, false);
-                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
+                if (first) gate_unlit(p, sq, k, occl);
                 continue;
             }
             const LightSample ls = ws.lights.get(k);
@@ -258,8 +237,7 @@ private:
             const Vec3f wi_world = sq.frame[k].to_world(sq.wi[k]);
             const bool reflects_only = !(m_spectra.bsdf_of(m_scene, sq.shape[k]).flags() & kTransmission);
             if (!ls.valid() || (reflects_only && sq.ng[k].dot(ls.wi) * sq.ng[k].dot(wi_world) <= 0.f)) {
-                if (first) m_latent->gate(p, slot, occl, false);
-                if (m_obs && first) m_obs->light_sample(slot, -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
+                if (first) gate_unlit(p, sq, k, occl);
                 continue;
             }
             Spectrum<N> contribution = Spectrum<N>::Zero();
@@ -272,7 +250,8 @@ private:
                 const Spectrum<N> f = bsdf.eval(ctx, sq.wi[k], wo);
                 // A zero f (a latent reflectance at 0) still has a derivative: keep it for the adjoint.
                 if ((f != 0.f).any() || m_keep_zero) {
-                    float w = m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
+                    float w =
+                        m_opt.strategy == LightStrategy::Nee ? 1.f : mis_power(ls.pdf, bsdf.pdf(ctx, sq.wi[k], wo));
                     float factor;
                     const Spectrum<N> le = emitted(ls.emitter, ls.wi, &factor);
                     contribution = nee_score(p.beta[slot], f, le, w / ls.pdf);
@@ -281,24 +260,57 @@ private:
                     continue;
                 }
             }
-            // Aim from the offset origin at the light point itself: reusing ls.wi from the
-            // un-offset point makes the ray cross the light's plane before tmax and hit the light
-            // (up to half the NEE energy lost under large, close lights).
-            Vec3f o = offset_ray_origin(sq.p[k], sq.ng[k], ls.wi);
-            Vec3f dir = ls.wi;
-            float tmax = kInf;
-            if (!m_scene.emitters[ls.emitter].is_environment()) {
-                Vec3f d = ls.p - o;
-                float dist = d.norm();
-                dir = d * (1.f / dist);
-                tmax = dist * (1.f - 1e-4f);
-            }
-            if (m_obs) m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, w_over_pdf, ctx, sq.wi[k], wo, nee, first);
-            ws.shadow.rays.push(o, dir, 0.f, tmax);
+            if (m_obs)
+                m_obs->light_sample(slot, int(ws.shadow.rays.size), sq.shape[k], ls.emitter, w_over_pdf, ctx, sq.wi[k],
+                                    wo, nee, first);
+            push_shadow_ray(ws.shadow.rays, sq.p[k], sq.ng[k], ls);
             ws.shadow.slot.push_back(slot);
             ws.shadow.contribution.push_back(contribution);
             if (m_latent) ws.shadow.occlusion.push_back(occl);
         }
+    }
+
+    /// Every shade entry's light sample at once (core/light_sampler.h): per vertex it is a long
+    /// dependent chain of square roots and divisions.
+    void draw_light_samples(Workspace<N>& ws, int depth) const {
+        const PathState<N>& p = ws.paths;
+        const ShadeQueue& sq = ws.shade;
+        LightBatch& lb = ws.lights;
+        lb.resize(sq.size());
+        for (size_t k = 0; k < sq.size(); ++k) {
+            const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler);
+            lb.rx[k] = sq.p[k].x();
+            lb.ry[k] = sq.p[k].y();
+            lb.rz[k] = sq.p[k].z();
+            lb.u_choice[k] = rng.get(dim::bounce(depth, dim::kLightChoice));
+            rng.get2(dim::bounce(depth, dim::kLightPos), lb.u_pos0[k], lb.u_pos1[k]);
+        }
+        m_scene.lights.sample_batch(m_scene.emitters, m_scene.shapes, sq.size(), lb);
+    }
+
+    /// A first vertex whose light sample is known to be unlit without a ray (no light, or an
+    /// attached shadow): Ĩc's gate with V = 0.
+    void gate_unlit(PathState<N>& p, const ShadeQueue& sq, size_t k, const Spectrum<N>& occl) const {
+        m_latent->gate(p, sq.slot[k], occl, false);
+        if (m_obs)
+            m_obs->light_sample(sq.slot[k], -1, sq.shape[k], -1, 0.f, BSDFContext{}, sq.wi[k], sq.wi[k], false, true);
+    }
+
+    /// The shadow ray from vertex p (normal ng) to the light sample. It aims from the offset
+    /// origin at the light point itself: reusing ls.wi from the un-offset point makes the ray
+    /// cross the light's plane before tmax and hit the light (up to half the NEE energy lost
+    /// under large, close lights).
+    void push_shadow_ray(RayArrays& rays, const Vec3f& p, const Vec3f& ng, const LightSample& ls) const {
+        Vec3f o = offset_ray_origin(p, ng, ls.wi);
+        Vec3f dir = ls.wi;
+        float tmax = kInf;
+        if (!m_scene.emitters[ls.emitter].is_environment()) {
+            Vec3f d = ls.p - o;
+            float dist = d.norm();
+            dir = d * (1.f / dist);
+            tmax = dist * (1.f - 1e-4f);
+        }
+        rays.push(o, dir, 0.f, tmax);
     }
 
     /// Stage 3: BSDF sampling (docs/transport.md (1)) and Russian roulette (4) → next rays.
@@ -312,12 +324,14 @@ private:
         for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0], &ws.cosine[1], &ws.cosine[2]})
             if (a->size() < n) a->resize(n);
         for (size_t k = 0; k < n; ++k) {
-            const BsdfRandoms u = bsdf_randoms(SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler), uint32_t(depth));
+            const BsdfRandoms u = bsdf_randoms(
+                SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler), uint32_t(depth));
             ws.u_lobe[k] = u.lobe;
             ws.u_dir[0][k] = u.dir[0];
             ws.u_dir[1][k] = u.dir[1];
         }
-        sample_cosine_hemisphere_batch(ws.u_dir[0].data(), ws.u_dir[1].data(), ws.cosine[0].data(), ws.cosine[1].data(), ws.cosine[2].data(), n);
+        sample_cosine_hemisphere_batch(ws.u_dir[0].data(), ws.u_dir[1].data(), ws.cosine[0].data(), ws.cosine[1].data(),
+                                       ws.cosine[2].data(), n);
         for (size_t k = 0; k < n; ++k) {
             if (!(sq.flags[k] & ShadeQueue::kContinue)) continue;
             const uint32_t slot = sq.slot[k];
@@ -328,8 +342,9 @@ private:
             const Lambertian lambertian = m_lambertian[sq.shape[k]];
             const BSDFSample<N> bs =
                 lambertian != Lambertian::No
-                    ? lambertian_sample<N>(lambertian, sq.wi[k], Vec3f(ws.cosine[0][k], ws.cosine[1][k], ws.cosine[2][k]),
-                                              bsdf.lambertian_reflectance(ctx))
+                    ? lambertian_sample<N>(lambertian, sq.wi[k],
+                                           Vec3f(ws.cosine[0][k], ws.cosine[1][k], ws.cosine[2][k]),
+                                           bsdf.lambertian_reflectance(ctx))
                     : bsdf.sample(ctx, sq.wi[k], ws.u_lobe[k], Vec2f(ws.u_dir[0][k], ws.u_dir[1][k]));
             if (!bs.valid()) continue;
             Spectrum<N> beta = p.beta[slot] * bs.weight;
@@ -369,9 +384,9 @@ private:
     const SceneSpectra<N>& m_spectra;
     const RenderOptions& m_opt;
     const Camera& m_camera;
-    PathObserver<N>* m_obs;                    ///< null unless an adjoint is replaying
-    std::optional<LatentStage<N>> m_latent;    ///< Ĩa, Ĩc: absent for plain (RGB) rendering
-    const bool m_emission;                     ///< Ĩe on
+    PathObserver<N>* m_obs;                  ///< null unless an adjoint is replaying
+    std::optional<LatentStage<N>> m_latent;  ///< Ĩa, Ĩc: absent for plain (RGB) rendering
+    const bool m_emission;                   ///< Ĩe on
     /// Latent renders keep zero-valued NEE samples and zero-throughput paths: their derivatives
     /// need not be zero. Decided by what is rendered, never by whether an observer listens.
     const bool m_keep_zero;
@@ -380,8 +395,9 @@ private:
 
 /// Shared driver: tiles in parallel, each tile's pixels owned by one task (deterministic).
 template <int N>
-void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>* terms, PathObserver<N>* observer,
-                  const RenderOptions& opt, const Camera& camera, Film<N>* const films[3], RenderStats* stats) {
+void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>* terms,
+                  PathObserver<N>* observer, const RenderOptions& opt, const Camera& camera, Film<N>* const films[3],
+                  RenderStats* stats) {
     auto t0 = std::chrono::steady_clock::now();
     const int tiles_x = (camera.width + kTile - 1) / kTile, tiles_y = (camera.height + kTile - 1) / kTile;
     const int n_tiles = tiles_x * tiles_y;
@@ -399,7 +415,8 @@ void render_tiles(const Scene& scene, const SceneSpectra<N>& spectra, const Late
         int x1 = std::min(x0 + kTile, camera.width), y1 = std::min(y0 + kTile, camera.height);
         int per_chunk = std::max(1, int(kWavefront / size_t((x1 - x0) * (y1 - y0))));
         RenderStats st;
-        for (int s0 = 0; s0 < opt.spp; s0 += per_chunk) tracer.trace_tile(ws, films, t, x0, y0, x1, y1, s0, std::min(per_chunk, opt.spp - s0), st);
+        for (int s0 = 0; s0 < opt.spp; s0 += per_chunk)
+            tracer.trace_tile(ws, films, t, x0, y0, x1, y1, s0, std::min(per_chunk, opt.spp - s0), st);
         {
             std::lock_guard<std::mutex> lock(stats_mutex);
             total.camera_rays += st.camera_rays;
@@ -421,7 +438,8 @@ int render_tile_count(int width, int height) { return ((width + kTile - 1) / kTi
 namespace {
 
 Camera render_camera(const Scene& scene, const RenderOptions& opt) {
-    return scene.camera.with_resolution(opt.width > 0 ? opt.width : scene.camera.width, opt.height > 0 ? opt.height : scene.camera.height);
+    return scene.camera.with_resolution(opt.width > 0 ? opt.width : scene.camera.width,
+                                        opt.height > 0 ? opt.height : scene.camera.height);
 }
 
 }  // namespace
@@ -441,7 +459,8 @@ TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spec
     if (terms.La.size() != scene.shapes.size() || terms.Lc.size() != scene.shapes.size())
         throw std::invalid_argument("render_latent_terms: La/Lc must hold one vector per shape");
     Camera camera = render_camera(scene, opt);
-    TermFilms<N> out{Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height)};
+    TermFilms<N> out{Film<N>(camera.width, camera.height), Film<N>(camera.width, camera.height),
+                     Film<N>(camera.width, camera.height)};
     Film<N>* const films[3] = {&out.e, &out.a, &out.c};
     render_tiles<N>(scene, spectra, &terms, observer, opt, camera, films, stats);
     return out;
@@ -456,8 +475,10 @@ std::vector<float> TermFilms<N>::sum() const {
 
 template Film<3> render_path<3>(const Scene&, const SceneSpectra<3>&, const RenderOptions&, RenderStats*);
 template Film<16> render_path<16>(const Scene&, const SceneSpectra<16>&, const RenderOptions&, RenderStats*);
-template TermFilms<3> render_latent_terms<3>(const Scene&, const SceneSpectra<3>&, const LatentTerms<3>&, const RenderOptions&, RenderStats*, PathObserver<3>*);
-template TermFilms<16> render_latent_terms<16>(const Scene&, const SceneSpectra<16>&, const LatentTerms<16>&, const RenderOptions&, RenderStats*, PathObserver<16>*);
+template TermFilms<3> render_latent_terms<3>(const Scene&, const SceneSpectra<3>&, const LatentTerms<3>&,
+                                             const RenderOptions&, RenderStats*, PathObserver<3>*);
+template TermFilms<16> render_latent_terms<16>(const Scene&, const SceneSpectra<16>&, const LatentTerms<16>&,
+                                               const RenderOptions&, RenderStats*, PathObserver<16>*);
 template struct TermFilms<3>;
 template struct TermFilms<16>;
 

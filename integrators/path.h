@@ -24,8 +24,8 @@ enum class LightStrategy { Mis, Nee, Bsdf };
 struct RenderOptions {
     uint64_t seed = 0;
     int spp = 16;
-    int width = 0, height = 0;   ///< 0 = the camera's resolution
-    int max_depth = 8;           ///< Mitsuba semantics: 1 = emitters seen directly; -1 = unbounded
+    int width = 0, height = 0;  ///< 0 = the camera's resolution
+    int max_depth = 8;          ///< Mitsuba semantics: 1 = emitters seen directly; -1 = unbounded
     int rr_depth = 5;
     LightStrategy strategy = LightStrategy::Mis;
     SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
@@ -43,7 +43,8 @@ struct RenderStats {
 };
 
 template <int N>
-Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& options, RenderStats* stats = nullptr);
+Film<N> render_path(const Scene& scene, const SceneSpectra<N>& spectra, const RenderOptions& options,
+                    RenderStats* stats = nullptr);
 
 /// The latent renderer's terms beyond light transport (docs/transport.md, latent section).
 template <int N>
@@ -56,7 +57,7 @@ struct LatentTerms {
 
 template <int N>
 struct TermFilms {
-    Film<N> e, a, c;  ///< Ĩe (light transport), Ĩa (+ background), Ĩc
+    Film<N> e, a, c;                 ///< Ĩe (light transport), Ĩa (+ background), Ĩc
     std::vector<float> sum() const;  ///< developed Ĩe + Ĩa + Ĩc, N floats per pixel
 };
 
@@ -67,7 +68,8 @@ struct TermFilms {
 /// since their derivatives need not be zero (RGB renders drop them).
 template <int N>
 TermFilms<N> render_latent_terms(const Scene& scene, const SceneSpectra<N>& spectra, const LatentTerms<N>& terms,
-                                 const RenderOptions& options, RenderStats* stats = nullptr, PathObserver<N>* observer = nullptr);
+                                 const RenderOptions& options, RenderStats* stats = nullptr,
+                                 PathObserver<N>* observer = nullptr);
 
 /// Image tiles of a render at this resolution (observers index per-tile buffers by tile).
 int render_tile_count(int width, int height);

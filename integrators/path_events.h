@@ -39,6 +39,8 @@ Spectrum<N> occlusion_score(const Spectrum<N>& beta, const Spectrum<N>& lc) {
 
 /// Whether Ĩc counts for a light sample whose shadow ray is (not) blocked. A light sample that
 /// needs no ray (attached shadow, no light) is not visible.
-inline bool occlusion_gate_passes(OcclusionGate gate, bool visible) { return visible != (gate == OcclusionGate::Shadowed); }
+inline bool occlusion_gate_passes(OcclusionGate gate, bool visible) {
+    return visible != (gate == OcclusionGate::Shadowed);
+}
 
 }  // namespace lpt

@@ -41,20 +41,28 @@ struct RayArrays {
 /// slots in the order of the current RayArrays.
 template <int N>
 struct PathState {
-    AlignedVector<Spectrum<N>> beta;       ///< throughput (signed for latents)
-    AlignedVector<Spectrum<N>> radiance;   ///< accumulated estimate
-    std::vector<uint32_t> pixel, sample;   ///< film pixel and sample index
-    std::vector<uint64_t> key;             ///< SampleStream key of (seed, pixel, sample), hashed once
-    std::vector<float> prev_pdf;           ///< solid-angle pdf of the last BSDF sample (MIS)
-    std::vector<uint8_t> prev_delta;       ///< last scattering was a delta lobe (or camera)
-    AlignedVector<Vec3f> prev_p;           ///< last vertex position (area-light pdf on hits)
+    AlignedVector<Spectrum<N>> beta;                ///< throughput (signed for latents)
+    AlignedVector<Spectrum<N>> radiance;            ///< accumulated estimate
+    std::vector<uint32_t> pixel, sample;            ///< film pixel and sample index
+    std::vector<uint64_t> key;                      ///< SampleStream key of (seed, pixel, sample), hashed once
+    std::vector<float> prev_pdf;                    ///< solid-angle pdf of the last BSDF sample (MIS)
+    std::vector<uint8_t> prev_delta;                ///< last scattering was a delta lobe (or camera)
+    AlignedVector<Vec3f> prev_p;                    ///< last vertex position (area-light pdf on hits)
     AlignedVector<Spectrum<N>> ambient, occlusion;  ///< latent Ĩa (+ background) and Ĩc
-    std::vector<uint8_t> past_first;       ///< the first non-delta vertex is behind us (latent)
+    std::vector<uint8_t> past_first;                ///< the first non-delta vertex is behind us (latent)
 
     void resize(size_t n) {
-        beta.resize(n); radiance.resize(n); pixel.resize(n); sample.resize(n); key.resize(n);
-        prev_pdf.resize(n); prev_delta.resize(n); prev_p.resize(n);
-        ambient.resize(n); occlusion.resize(n); past_first.resize(n);
+        beta.resize(n);
+        radiance.resize(n);
+        pixel.resize(n);
+        sample.resize(n);
+        key.resize(n);
+        prev_pdf.resize(n);
+        prev_delta.resize(n);
+        prev_p.resize(n);
+        ambient.resize(n);
+        occlusion.resize(n);
+        past_first.resize(n);
     }
 };
 
@@ -72,8 +80,14 @@ struct ShadeQueue {
     void reset(size_t capacity) {
         count = 0;
         if (slot.size() >= capacity) return;
-        slot.resize(capacity); shape.resize(capacity); p.resize(capacity); ng.resize(capacity);
-        wi.resize(capacity); frame.resize(capacity); uv.resize(capacity); flags.resize(capacity);
+        slot.resize(capacity);
+        shape.resize(capacity);
+        p.resize(capacity);
+        ng.resize(capacity);
+        wi.resize(capacity);
+        frame.resize(capacity);
+        uv.resize(capacity);
+        flags.resize(capacity);
     }
     size_t size() const { return count; }
 };
@@ -85,7 +99,12 @@ struct ShadowQueue {
     std::vector<uint32_t> slot;
     AlignedVector<Spectrum<N>> contribution;  ///< NEE: added if unblocked
     AlignedVector<Spectrum<N>> occlusion;     ///< latent β·L̃c: added if the gate opens (else empty)
-    void clear() { rays.clear(); slot.clear(); contribution.clear(); occlusion.clear(); }
+    void clear() {
+        rays.clear();
+        slot.clear();
+        contribution.clear();
+        occlusion.clear();
+    }
 };
 
 }  // namespace lpt

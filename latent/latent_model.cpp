@@ -22,10 +22,13 @@ struct SliceSpec {
 /// docs/params.md: the two parameterisations, per kind of vector.
 SliceSpec spec_for(Parameterisation p, bool reflectance_like) {
     if (p == Parameterisation::Code)
-        return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f} : SliceSpec{ParamMap::Identity, -6.f, 6.f, -0.1f, 0.1f};
+        return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f}
+                                : SliceSpec{ParamMap::Identity, -6.f, 6.f, -0.1f, 0.1f};
     if (p == Parameterisation::Classic)  // non-negative; radiances start small so the render starts inside (0, 1)
-        return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f} : SliceSpec{ParamMap::Identity, 0.f, 1e4f, 0.f, 0.2f};
-    return reflectance_like ? SliceSpec{ParamMap::PosNeg, 0.f, 1.f, 0.f, 1.f} : SliceSpec{ParamMap::PosNeg, 0.f, 1e30f, 0.f, 1.f};
+        return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f}
+                                : SliceSpec{ParamMap::Identity, 0.f, 1e4f, 0.f, 0.2f};
+    return reflectance_like ? SliceSpec{ParamMap::PosNeg, 0.f, 1.f, 0.f, 1.f}
+                            : SliceSpec{ParamMap::PosNeg, 0.f, 1e30f, 0.f, 1.f};
 }
 
 }  // namespace
@@ -47,9 +50,11 @@ LatentModel::LatentModel(const Scene& scene, Parameterisation p, uint64_t seed) 
             sl.La = add(shape.id + ".La", "La", false);
             sl.Lc = add(shape.id + ".Lc", "Lc", false);
         }
-        for (const std::string& key : bsdf.spectral_keys()) sl.bsdf.emplace_back(key, add(shape.id + ".bsdf." + key, "reflectance", true));
+        for (const std::string& key : bsdf.spectral_keys())
+            sl.bsdf.emplace_back(key, add(shape.id + ".bsdf." + key, "reflectance", true));
         for (const std::string& key : bsdf.scalar_keys())
-            sl.scalar.emplace_back(key, m_params.add(shape.id + ".bsdf." + key, key, ParamMap::Sigmoid, 1, -1e30f, 1e30f));
+            sl.scalar.emplace_back(key,
+                                   m_params.add(shape.id + ".bsdf." + key, key, ParamMap::Sigmoid, 1, -1e30f, 1e30f));
     }
     if (m_scene.environment >= 0) m_env_slot = add("environment.Le", "Le", false);
     m_background = add("background", "background", false);
@@ -57,7 +62,8 @@ LatentModel::LatentModel(const Scene& scene, Parameterisation p, uint64_t seed) 
     // Deterministic init: one seed, a distinct stream per kind.
     const SliceSpec radiance = spec_for(p, false), refl = spec_for(p, true);
     uint64_t k = 0;
-    for (const char* kind : {"Le", "La", "Lc", "background"}) m_params.init_uniform(kind, radiance.init_a, radiance.init_b, mix64(seed + ++k));
+    for (const char* kind : {"Le", "La", "Lc", "background"})
+        m_params.init_uniform(kind, radiance.init_a, radiance.init_b, mix64(seed + ++k));
     m_params.init_uniform("reflectance", refl.init_a, refl.init_b, mix64(seed + ++k));
 
     // Scalars (roughness) start where the scene file puts them, inside the sigmoid's range.

@@ -34,8 +34,8 @@ public:
 
     struct ShapeSlots {
         int Le = -1, La = -1, Lc = -1;
-        std::vector<std::pair<std::string, int>> bsdf;  ///< (coefficient key, slice)
-        std::vector<std::pair<std::string, int>> scalar; ///< (scalar key, 1-channel slice), e.g. alpha
+        std::vector<std::pair<std::string, int>> bsdf;    ///< (coefficient key, slice)
+        std::vector<std::pair<std::string, int>> scalar;  ///< (scalar key, 1-channel slice), e.g. alpha
     };
 
     /// Writes ParamStore values into spectra and terms (call after every optimiser step).

@@ -9,9 +9,12 @@ namespace lpt {
 
 const char* to_string(ParamMap m) {
     switch (m) {
-        case ParamMap::Identity: return "identity";
-        case ParamMap::Sigmoid: return "sigmoid";
-        case ParamMap::PosNeg: return "posneg";
+        case ParamMap::Identity:
+            return "identity";
+        case ParamMap::Sigmoid:
+            return "sigmoid";
+        case ParamMap::PosNeg:
+            return "posneg";
     }
     return "?";
 }
@@ -25,7 +28,8 @@ ParamMap param_map_from_string(const std::string& s) {
 
 int ParamStore::add(const std::string& name, const std::string& kind, ParamMap map, int channels, float lo, float hi) {
     if (find(name) >= 0) throw std::invalid_argument("duplicate parameter '" + name + "'");
-    if (channels <= 0 || !(lo <= hi)) throw std::invalid_argument("parameter '" + name + "': bad channel count or range");
+    if (channels <= 0 || !(lo <= hi))
+        throw std::invalid_argument("parameter '" + name + "': bad channel count or range");
     ParamSlice s;
     s.name = name;
     s.kind = kind;
@@ -56,16 +60,19 @@ void ParamStore::set_value(int i, const float* v) {
     for (int c = 0; c < s.channels; ++c) {
         switch (s.map) {
             case ParamMap::Identity:
-                if (v[c] < s.lo || v[c] > s.hi) throw std::invalid_argument("parameter '" + s.name + "': value outside its range");
+                if (v[c] < s.lo || v[c] > s.hi)
+                    throw std::invalid_argument("parameter '" + s.name + "': value outside its range");
                 r[c] = v[c];
                 break;
             case ParamMap::Sigmoid:
-                if (!(v[c] > 0.f && v[c] < 1.f)) throw std::invalid_argument("parameter '" + s.name + "': sigmoid value must be in (0, 1)");
+                if (!(v[c] > 0.f && v[c] < 1.f))
+                    throw std::invalid_argument("parameter '" + s.name + "': sigmoid value must be in (0, 1)");
                 r[c] = std::log(v[c] / (1.f - v[c]));
                 break;
             case ParamMap::PosNeg: {
                 float pos = std::max(v[c], 0.f), neg = std::max(-v[c], 0.f);
-                if (pos + s.lo > s.hi || neg + s.lo > s.hi) throw std::invalid_argument("parameter '" + s.name + "': value outside its range");
+                if (pos + s.lo > s.hi || neg + s.lo > s.hi)
+                    throw std::invalid_argument("parameter '" + s.name + "': value outside its range");
                 r[c] = pos + s.lo;  // lo is normally 0; both parts start at lo
                 r[c + s.channels] = neg + s.lo;
                 break;
@@ -81,11 +88,17 @@ void ParamStore::update_values() {
         float* v = m_value.data() + s.value_offset;
         for (int c = 0; c < s.channels; ++c) {
             switch (s.map) {
-                case ParamMap::Identity: v[c] = r[c]; break;
-                case ParamMap::Sigmoid: v[c] = 1.f / (1.f + std::exp(-r[c])); break;
+                case ParamMap::Identity:
+                    v[c] = r[c];
+                    break;
+                case ParamMap::Sigmoid:
+                    v[c] = 1.f / (1.f + std::exp(-r[c]));
+                    break;
                 // docs/params.md (3): the parts are kept inside [lo, hi] by clamp_raw, so the
                 // difference is taken as is.
-                case ParamMap::PosNeg: v[c] = r[c] - r[c + s.channels]; break;
+                case ParamMap::PosNeg:
+                    v[c] = r[c] - r[c + s.channels];
+                    break;
             }
         }
     }
@@ -98,8 +111,12 @@ void ParamStore::backward() {
         float* gr = m_grad_raw.data() + s.raw_offset;
         for (int c = 0; c < s.channels; ++c) {
             switch (s.map) {
-                case ParamMap::Identity: gr[c] = gv[c]; break;
-                case ParamMap::Sigmoid: gr[c] = gv[c] * v[c] * (1.f - v[c]); break;
+                case ParamMap::Identity:
+                    gr[c] = gv[c];
+                    break;
+                case ParamMap::Sigmoid:
+                    gr[c] = gv[c] * v[c] * (1.f - v[c]);
+                    break;
                 case ParamMap::PosNeg:
                     gr[c] = gv[c];
                     gr[c + s.channels] = -gv[c];
@@ -127,7 +144,8 @@ void ParamStore::init_uniform(const std::string& kind, float a, float b, uint64_
     for (size_t i = 0; i < m_slices.size(); ++i) {
         const ParamSlice& s = m_slices[i];
         if (s.kind != kind) continue;
-        for (size_t k = 0; k < s.raw_size(); ++k) m_raw[s.raw_offset + k] = a + (b - a) * sample_1d(seed, uint32_t(i), uint32_t(k), 0);
+        for (size_t k = 0; k < s.raw_size(); ++k)
+            m_raw[s.raw_offset + k] = a + (b - a) * sample_1d(seed, uint32_t(i), uint32_t(k), 0);
     }
     clamp_raw();
 }
@@ -143,7 +161,8 @@ std::string ParamStore::to_json() const {
         e["lo"] = s.lo;
         e["hi"] = s.hi;
         e["raw"] = std::vector<float>(m_raw.begin() + s.raw_offset, m_raw.begin() + s.raw_offset + s.raw_size());
-        e["value"] = std::vector<float>(m_value.begin() + s.value_offset, m_value.begin() + s.value_offset + s.channels);
+        e["value"] =
+            std::vector<float>(m_value.begin() + s.value_offset, m_value.begin() + s.value_offset + s.channels);
         j["slices"].push_back(e);
     }
     return j.dump(1);
@@ -156,20 +175,29 @@ void ParamStore::load_json(const std::string& text, const std::string& file) {
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(file + ": malformed JSON: " + e.what());
     }
-    if (!j.contains("slices") || !j["slices"].is_array()) throw std::runtime_error(file + ": field 'slices' missing or not an array");
+    if (!j.contains("slices") || !j["slices"].is_array())
+        throw std::runtime_error(file + ": field 'slices' missing or not an array");
     for (const auto& e : j["slices"]) {
         std::string name = e.value("name", "");
         int i = find(name);
-        if (i < 0) throw std::runtime_error(file + ": unknown parameter '" + name + "' (no shape or kind of that name in this scene)");
+        if (i < 0)
+            throw std::runtime_error(file + ": unknown parameter '" + name +
+                                     "' (no shape or kind of that name in this scene)");
         const ParamSlice& s = m_slices[i];
         if (!e.contains("raw") || !e["raw"].is_array() || e["raw"].size() != s.raw_size())
-            throw std::runtime_error(file + ": parameter '" + name + "': 'raw' must hold " + std::to_string(s.raw_size()) + " numbers");
+            throw std::runtime_error(file + ": parameter '" + name + "': 'raw' must hold " +
+                                     std::to_string(s.raw_size()) + " numbers");
         if (e.contains("map") && e["map"] != to_string(s.map))
-            throw std::runtime_error(file + ": parameter '" + name + "': map '" + e["map"].get<std::string>() + "' but this fit uses '" + to_string(s.map) + "'");
+            throw std::runtime_error(file + ": parameter '" + name + "': map '" + e["map"].get<std::string>() +
+                                     "' but this fit uses '" + to_string(s.map) + "'");
         for (size_t k = 0; k < s.raw_size(); ++k) {
-            if (!e["raw"][k].is_number()) throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) + "] is not a number");
+            if (!e["raw"][k].is_number())
+                throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) +
+                                         "] is not a number");
             float v = e["raw"][k].get<float>();
-            if (!std::isfinite(v)) throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) + "] is not finite");
+            if (!std::isfinite(v))
+                throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) +
+                                         "] is not finite");
             m_raw[s.raw_offset + k] = v;
         }
     }

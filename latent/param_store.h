@@ -20,11 +20,11 @@ const char* to_string(ParamMap m);
 ParamMap param_map_from_string(const std::string& s);  ///< throws std::invalid_argument
 
 struct ParamSlice {
-    std::string name;     ///< unique, "<shape id>.<kind>"
-    std::string kind;     ///< "Le", "La", "Lc", "reflectance", "specular_reflectance", "alpha", "background", ...
+    std::string name;  ///< unique, "<shape id>.<kind>"
+    std::string kind;  ///< "Le", "La", "Lc", "reflectance", "specular_reflectance", "alpha", "background", ...
     ParamMap map = ParamMap::Identity;
     int channels = 0;
-    size_t raw_offset = 0;    ///< PosNeg holds `channels` pos entries then `channels` neg entries
+    size_t raw_offset = 0;  ///< PosNeg holds `channels` pos entries then `channels` neg entries
     size_t value_offset = 0;
     float lo = -6.f, hi = 6.f;
     size_t raw_size() const { return map == ParamMap::PosNeg ? 2 * size_t(channels) : size_t(channels); }

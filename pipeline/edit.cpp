@@ -37,8 +37,10 @@ Tools open_tools(const EditJob& job, const FitFolder& fit, const Reporter& repor
     const fs::path dir(job.fitdir);
     const bool have_vae = vae_present(fit.vae);
     if (job.reference && !have_vae)
-        throw std::runtime_error("--reference needs the fit's VAE to encode references; not found: " + default_vae_dir(fit.vae.dir));
-    if (!have_vae) report.say("note: the fit's VAE is not here (" + default_vae_dir(fit.vae.dir) + "): writing latents only");
+        throw std::runtime_error("--reference needs the fit's VAE to encode references; not found: " +
+                                 default_vae_dir(fit.vae.dir));
+    if (!have_vae)
+        report.say("note: the fit's VAE is not here (" + default_vae_dir(fit.vae.dir) + "): writing latents only");
     Tools t;
     // Stage 2, when the fit trained one: every frame is refined from its latent and AOVs.
     if (fs::exists(dir / "refiner.pt")) t.refiner = Refiner::load((dir / "refiner.pt").string());
@@ -67,12 +69,13 @@ std::string metrics_header(bool refined) {
 /// One frame's errors against the encoded reference (docs/metrics.md): latent MSE, PSNR over the
 /// data range 6, D-SSIM = 1 − SSIM (range 6); decoded RGB (clamped to [0, 1]) MSE × 100, SSIM,
 /// LPIPS against the display-mapped reference. Empty where the image is below a metric's size.
-std::string frame_metrics(const std::vector<float>& latent, const std::vector<float>& ref, const std::vector<float>& ref_rgb, int w, int h,
-                          const Tools& t) {
+std::string frame_metrics(const std::vector<float>& latent, const std::vector<float>& ref,
+                          const std::vector<float>& ref_rgb, int w, int h, const Tools& t) {
     const double mse = mse_loss(latent.data(), ref.data(), ref.size());
     std::ostringstream o;
     o << "," << mse << "," << 10.0 * std::log10(36.0 / std::max(mse, 1e-12)) << ",";  // data range 6 (±3)
-    if (w >= kSsimWindow && h >= kSsimWindow) o << 1.0 - ssim(latent.data(), ref.data(), w, h, kLatentChannels, kLatentDataRange);
+    if (w >= kSsimWindow && h >= kSsimWindow)
+        o << 1.0 - ssim(latent.data(), ref.data(), w, h, kLatentChannels, kLatentDataRange);
     o << ",";
     if (!t.vae) {
         o << ",,";
@@ -83,7 +86,8 @@ std::string frame_metrics(const std::vector<float>& latent, const std::vector<fl
     o << 100.0 * mse_loss(rgb.data(), ref_rgb.data(), rgb.size()) << ",";
     if (8 * w >= kSsimWindow && 8 * h >= kSsimWindow) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
     o << ",";
-    if (t.lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize) o << t.lpips->distance(rgb, ref_rgb, 8 * w, 8 * h);
+    if (t.lpips && 8 * w >= Lpips::kMinSize && 8 * h >= Lpips::kMinSize)
+        o << t.lpips->distance(rgb, ref_rgb, 8 * w, 8 * h);
     return o.str();
 }
 
@@ -95,8 +99,8 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
     fs::path cached;
     if (!job.reference_cache.empty()) {
         char key[160];
-        std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s.exr", fs::path(job.edits).stem().string().c_str(), 8 * w, 8 * h, job.ref_spp,
-                      fit.ref_tone.c_str(), frame.c_str());
+        std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s.exr", fs::path(job.edits).stem().string().c_str(), 8 * w,
+                      8 * h, job.ref_spp, fit.ref_tone.c_str(), frame.c_str());
         cached = fs::path(job.reference_cache) / key;
     }
     if (!cached.empty() && fs::exists(cached)) {
@@ -107,7 +111,8 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
         write_png_display(stem + "_reference.png", Image{8 * w, 8 * h, 3, ref_rgb, {}});
         return t.vae->encode(ref_rgb, 8 * w, 8 * h);
     }
-    std::vector<float> ref = encoded_reference_of(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae, stem + "_reference.png", &ref_rgb);
+    std::vector<float> ref = encoded_reference_of(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae,
+                                                  stem + "_reference.png", &ref_rgb);
     if (!cached.empty()) {
         fs::create_directories(cached.parent_path());
         write_exr(cached.string(), Image{8 * w, 8 * h, 3, ref_rgb, {"R", "G", "B"}});
@@ -117,7 +122,8 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
 
 /// Renders, refines and decodes frame `i` (the scene already edited); returns its metrics row
 /// (empty without job.reference).
-std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& t, int i, float time, int w, int h, const fs::path& out) {
+std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& t, int i, float time, int w, int h,
+                         const fs::path& out) {
     RenderOptions ro = RenderOptions::from_scene(*fit.scene);
     ro.width = w;
     ro.height = h;
@@ -137,7 +143,8 @@ std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& 
     }
     if (t.vae) {
         // frame_NNNN.png is the result (refined when there is a refiner); _rendered.png the unrefined one.
-        write_png_display(stem + (t.refiner ? "_rendered.png" : ".png"), Image{8 * w, 8 * h, 3, t.vae->decode(latent, w, h), {}});
+        write_png_display(stem + (t.refiner ? "_rendered.png" : ".png"),
+                          Image{8 * w, 8 * h, 3, t.vae->decode(latent, w, h), {}});
         if (t.refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, t.vae->decode(refined, w, h), {}});
     }
     if (!job.reference) return {};
@@ -152,7 +159,8 @@ std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& 
 }  // namespace
 
 int render_edits(const EditJob& job, const Reporter& report) {
-    if (!fs::is_directory(job.fitdir)) throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
+    if (!fs::is_directory(job.fitdir))
+        throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
     FitFolder fit = load_fit_folder(job.fitdir, job.defines);
     Scene& scene = *fit.scene;
     const int w = job.width > 0 ? job.width : fit.latent_width, h = job.height > 0 ? job.height : fit.latent_height;

@@ -16,10 +16,10 @@ struct EditJob {
     std::map<std::string, std::string> defines;  ///< override the fit's -D values
     int width = 0, height = 0;                   ///< latent resolution; 0 = the fit's
     int spp = 64;
-    uint64_t seed = 0;                           ///< frame i uses seed + i
+    uint64_t seed = 0;  ///< frame i uses seed + i
     bool reference = false;
     int ref_spp = 256;
-    std::string reference_cache;                 ///< keeps path-traced reference frames for reuse
+    std::string reference_cache;  ///< keeps path-traced reference frames for reuse
 };
 
 /// Returns the number of frames written. Throws Cancelled when the reporter cancels.

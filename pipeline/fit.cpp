@@ -36,12 +36,13 @@ void parse_dimension(const std::string& s, int& w, int& h) {
 Target load_target_exr(const std::string& path) {
     Image img = read_image(path);
     if (img.channels != kLatentChannels)
-        throw std::runtime_error(path + ": target has " + std::to_string(img.channels) + " channels, a latent map needs " +
-                                 std::to_string(kLatentChannels) + " (an RGB image needs --encode)");
+        throw std::runtime_error(path + ": target has " + std::to_string(img.channels) +
+                                 " channels, a latent map needs " + std::to_string(kLatentChannels) +
+                                 " (an RGB image needs --encode)");
     size_t bad = 0;
     if (!check_finite(img.data.data(), img.data.size(), &bad))
-        throw std::runtime_error(path + ": value at pixel (" + std::to_string(bad / kLatentChannels % img.width) + ", " +
-                                 std::to_string(bad / kLatentChannels / img.width) + "), channel " +
+        throw std::runtime_error(path + ": value at pixel (" + std::to_string(bad / kLatentChannels % img.width) +
+                                 ", " + std::to_string(bad / kLatentChannels / img.width) + "), channel " +
                                  std::to_string(bad % kLatentChannels) + " is not finite");
     return {img.data, img.width, img.height};
 }
@@ -54,7 +55,8 @@ Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, con
     const fs::path out(job.out);
     std::vector<float> ref_rgb;
     Target t;
-    t.data = encoded_reference_of(scene, iw, ih, job.ref_spp, job.ref_tone, vae, (out / "reference.png").string(), &ref_rgb, report);
+    t.data = encoded_reference_of(scene, iw, ih, job.ref_spp, job.ref_tone, vae, (out / "reference.png").string(),
+                                  &ref_rgb, report);
     write_exr((out / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}});
     t.width = iw / 8;
     t.height = ih / 8;
@@ -79,7 +81,8 @@ Target synthetic_target(const FitJob& job, const Scene& scene) {
 std::string loss_csv(const FitState& st) {
     std::ostringstream out;
     out << "iteration,loss,smoothed_loss,lr,seconds\n";
-    for (const FitRecord& r : st.history) out << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.lr << "," << r.seconds << "\n";
+    for (const FitRecord& r : st.history)
+        out << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.lr << "," << r.seconds << "\n";
     return out.str();
 }
 
@@ -97,7 +100,8 @@ bool optimise(LatentModel& model, const Target& target, const FitOptions& o, Fit
     auto on_iteration = [&](const FitRecord& r, const FitState& st) {
         if (r.refused && st.skipped_steps <= 10)
             report.say("warning: iteration " + std::to_string(r.iteration) + ": non-finite gradient, step skipped (" +
-                       std::to_string(st.skipped_steps) + " so far)" + (st.skipped_steps == 10 ? "; further warnings suppressed" : ""));
+                       std::to_string(st.skipped_steps) + " so far)" +
+                       (st.skipped_steps == 10 ? "; further warnings suppressed" : ""));
         StageProgress p;
         p.stage = "fit";
         p.step = r.iteration + 1;
@@ -127,12 +131,14 @@ void write_latent_pictures(const fs::path& out, const Target& target, const std:
 void write_decoded(const fs::path& out, const Vae& vae, const Target& target, const std::vector<float>& toned) {
     const int f = vae.convention().downsample, w = target.width, h = target.height;
     write_png_display((out / "decoded.png").string(), Image{w * f, h * f, 3, vae.decode(toned, w, h), {"R", "G", "B"}});
-    write_png_display((out / "target_decoded.png").string(), Image{w * f, h * f, 3, vae.decode(target.data, w, h), {"R", "G", "B"}});
+    write_png_display((out / "target_decoded.png").string(),
+                      Image{w * f, h * f, 3, vae.decode(target.data, w, h), {"R", "G", "B"}});
 }
 
 /// The final render of the best parameters at final_spp and everything stage 2 and `render
 /// --edit` read: params.json, fit.json, latent*.exr, aov.exr, loss.csv, pictures.
-double write_stage1(const FitJob& job, const LatentModel& model, const Target& target, const FitState& state, const Vae* vae) {
+double write_stage1(const FitJob& job, const LatentModel& model, const Target& target, const FitState& state,
+                    const Vae* vae) {
     const fs::path out(job.out);
     const int w = target.width, h = target.height;
     RenderOptions ro = RenderOptions::from_scene(model.scene());
@@ -140,7 +146,8 @@ double write_stage1(const FitJob& job, const LatentModel& model, const Target& t
     ro.height = h;
     ro.spp = job.final_spp;
     ro.seed = job.options.seed + 1;
-    TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro);
+    TermFilms<kLatentChannels> films =
+        render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro);
     std::vector<float> linear = films.sum(), toned(linear.size());
     tone_map(job.options.tone, linear.data(), toned.data(), linear.size());
     const double final_loss = huber_loss(toned.data(), target.data.data(), toned.size(), 1.f, nullptr);
@@ -162,10 +169,11 @@ std::string stage1_summary(const FitState& state) {
     char buf[160];
     // With patience 0 nothing tracks a best iteration: the last parameters are kept.
     if (state.best_iteration >= 0)
-        std::snprintf(buf, sizeof buf, "[fit] best smoothed loss %.5f at iteration %d; %d refused steps", state.best_loss,
-                      state.best_iteration, state.skipped_steps);
+        std::snprintf(buf, sizeof buf, "[fit] best smoothed loss %.5f at iteration %d; %d refused steps",
+                      state.best_loss, state.best_iteration, state.skipped_steps);
     else
-        std::snprintf(buf, sizeof buf, "[fit] early stopping off: the last iteration's parameters are kept; %d refused steps",
+        std::snprintf(buf, sizeof buf,
+                      "[fit] early stopping off: the last iteration's parameters are kept; %d refused steps",
                       state.skipped_steps);
     return buf;
 }
@@ -209,7 +217,8 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     summary.latent_width = target.width;
     summary.latent_height = target.height;
     summary.final_loss = write_stage1(job, model, target, summary.state, vae.get());
-    report.say("wrote " + job.out + "/{params.json, latent*.exr, aov.exr, loss.csv, target|render|diff.png}; Huber loss at " +
+    report.say("wrote " + job.out +
+               "/{params.json, latent*.exr, aov.exr, loss.csv, target|render|diff.png}; Huber loss at " +
                std::to_string(job.final_spp) + " spp: " + std::to_string(summary.final_loss));
     if (job.refiner) {
         RefineJob r = job.refine;

@@ -19,26 +19,26 @@ struct FitJob {
     std::string out = "fit-out";                 ///< the fit folder
 
     // The target: `target` if given, else the encoded RGB reference with `encode`, else synthetic.
-    std::string target;                    ///< 16-channel float EXR at latent resolution
-    bool encode = false;                   ///< target = VAE encoding of the scene path traced in RGB
-    std::string encode_res = "256x256";    ///< image resolution for `encode` (latent = image / 8)
+    std::string target;                  ///< 16-channel float EXR at latent resolution
+    bool encode = false;                 ///< target = VAE encoding of the scene path traced in RGB
+    std::string encode_res = "256x256";  ///< image resolution for `encode` (latent = image / 8)
     int ref_spp = 256;
-    std::string ref_tone = "clip";         ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
-    std::string synthetic_res = "32x32";   ///< latent resolution of the synthetic target
+    std::string ref_tone = "clip";        ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
+    std::string synthetic_res = "32x32";  ///< latent resolution of the synthetic target
     uint64_t synthetic_seed = 1;
 
     // The model and its optimisation. options.seed seeds the parameters, every iteration's paths,
     // the final render (seed + 1) and the refiner; options.checkpoint_dir is <out>/checkpoint.
-    std::string param = "code";            ///< parameterisation: code, paper, classic
-    std::string gate = "shadowed";         ///< Ĩc gate: shadowed (1 − V) or visible (V)
-    std::string terms = "eac";             ///< latent terms rendered: any of e, a, c
+    std::string param = "code";     ///< parameterisation: code, paper, classic
+    std::string gate = "shadowed";  ///< Ĩc gate: shadowed (1 − V) or visible (V)
+    std::string terms = "eac";      ///< latent terms rendered: any of e, a, c
     FitOptions options;
-    int final_spp = 256;                   ///< samples per pixel of the final render
-    bool resume = false;                   ///< continue from <out>/checkpoint (and the refiner's)
+    int final_spp = 256;  ///< samples per pixel of the final render
+    bool resume = false;  ///< continue from <out>/checkpoint (and the refiner's)
     VaeSource vae;
 
-    bool refiner = true;                   ///< run stage 2 afterwards
-    RefineJob refine;                      ///< stage-2 settings (fitdir, seed and resume are filled in)
+    bool refiner = true;  ///< run stage 2 afterwards
+    RefineJob refine;     ///< stage-2 settings (fitdir, seed and resume are filled in)
 };
 
 /// Checks the job's names and letters (param, gate, terms, tones); throws std::invalid_argument.

@@ -27,11 +27,14 @@ void set_terms(LatentTerms<kLatentChannels>& t, const std::string& gate, const s
 
 }  // namespace
 
-void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) { set_terms(model.terms(), gate, terms); }
+void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {
+    set_terms(model.terms(), gate, terms);
+}
 
 FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::string, std::string>& overrides) {
     const fs::path dir(dir_name);
-    if (!fs::is_directory(dir)) throw std::runtime_error(dir_name + ": not a folder (expected a fit folder made by latentpt fit)");
+    if (!fs::is_directory(dir))
+        throw std::runtime_error(dir_name + ": not a folder (expected a fit folder made by latentpt fit)");
     const std::string manifest_path = (dir / "fit.json").string();
     if (!fs::exists(manifest_path)) throw std::runtime_error(manifest_path + ": missing: not a latentpt fit folder");
     FitFolder f;
@@ -61,19 +64,30 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
 
 nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, const FitState& state) {
     const FitOptions& o = job.options;
-    nlohmann::json m = {{"scene", fs::absolute(job.scene).string()}, {"defines", job.defines}, {"param", job.param},
-                        {"gate", job.gate}, {"terms", job.terms}, {"tone", to_string(o.tone)}, {"latent_width", w},
-                        {"latent_height", h}, {"seed", o.seed}, {"vae_dir", default_vae_dir(job.vae.dir)},
+    nlohmann::json m = {{"scene", fs::absolute(job.scene).string()},
+                        {"defines", job.defines},
+                        {"param", job.param},
+                        {"gate", job.gate},
+                        {"terms", job.terms},
+                        {"tone", to_string(o.tone)},
+                        {"latent_width", w},
+                        {"latent_height", h},
+                        {"seed", o.seed},
+                        {"vae_dir", default_vae_dir(job.vae.dir)},
                         {"ref_tone", job.ref_tone}};
     if (job.vae.torchscript())
         m["vae_torchscript"] = {{"encoder", fs::absolute(job.vae.encoder).string()},
                                 {"decoder", fs::absolute(job.vae.decoder).string()},
                                 {"config", fs::absolute(job.vae.config).string()}};
     // How stage 1 went, for comparing runs (e.g. --reuse-paths) without parsing logs.
-    m["stage1"] = {{"final_loss", final_loss}, {"final_spp", job.final_spp}, {"iterations_run", state.next_iteration},
+    m["stage1"] = {{"final_loss", final_loss},
+                   {"final_spp", job.final_spp},
+                   {"iterations_run", state.next_iteration},
                    {"best_iteration", state.best_iteration},
-                   {"seconds", state.history.empty() ? 0.0 : state.history.back().seconds}, {"spp", o.spp},
-                   {"reuse_paths", o.reuse_paths}, {"skipped_steps", state.skipped_steps}};
+                   {"seconds", state.history.empty() ? 0.0 : state.history.back().seconds},
+                   {"spp", o.spp},
+                   {"reuse_paths", o.reuse_paths},
+                   {"skipped_steps", state.skipped_steps}};
     return m;
 }
 
@@ -95,9 +109,10 @@ Image read_fit_image(const std::string& path, int channels, int w, int h) {
     if (!fs::exists(path)) throw std::runtime_error(path + ": missing (run latentpt fit first)");
     Image img = read_image(path);
     if (img.channels != channels || (w > 0 && (img.width != w || img.height != h)))
-        throw std::runtime_error(path + ": expected " + (w > 0 ? std::to_string(w) + "x" + std::to_string(h) + "x" : std::string()) +
-                                 std::to_string(channels) + ", found " + std::to_string(img.width) + "x" + std::to_string(img.height) +
-                                 "x" + std::to_string(img.channels));
+        throw std::runtime_error(path + ": expected " +
+                                 (w > 0 ? std::to_string(w) + "x" + std::to_string(h) + "x" : std::string()) +
+                                 std::to_string(channels) + ", found " + std::to_string(img.width) + "x" +
+                                 std::to_string(img.height) + "x" + std::to_string(img.channels));
     return img;
 }
 

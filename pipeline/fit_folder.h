@@ -23,13 +23,13 @@ struct FitJob;
 
 struct FitFolder {
     std::string dir;
-    nlohmann::json manifest;                 ///< fit.json
-    std::unique_ptr<Scene> scene;            ///< owned here: the model refers to it
+    nlohmann::json manifest;       ///< fit.json
+    std::unique_ptr<Scene> scene;  ///< owned here: the model refers to it
     std::unique_ptr<LatentModel> model;
     ToneCurve tone = ToneCurve::Clip;
     int latent_width = 0, latent_height = 0;
     std::string ref_tone = "clip";
-    VaeSource vae;                           ///< the VAE the fit used
+    VaeSource vae;  ///< the VAE the fit used
 };
 
 /// Throws std::runtime_error naming the file for a missing or malformed fit.json / params.json.
@@ -40,7 +40,8 @@ FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, st
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
 
 /// fit.json of a finished stage 1: everything load_fit_folder needs, plus how the stage went.
-nlohmann::json fit_manifest(const FitJob& job, int latent_width, int latent_height, double final_loss, const lpt::FitState& state);
+nlohmann::json fit_manifest(const FitJob& job, int latent_width, int latent_height, double final_loss,
+                            const lpt::FitState& state);
 
 /// The VAE recorded in a parsed fit.json (defaults resolved); manifest_vae reads the file.
 VaeSource vae_source_of(const nlohmann::json& manifest);

@@ -15,12 +15,13 @@ float display_value(float v, const std::string& tone) {
     return std::pow(v, 1.f / 2.2f);
 }
 
-std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const Vae& vae,
-                                        const std::string& save_png, std::vector<float>* display_rgb, const Reporter& report) {
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone,
+                                        const Vae& vae, const std::string& save_png, std::vector<float>* display_rgb,
+                                        const Reporter& report) {
     const int f = vae.convention().downsample;
     if (width % f || height % f)
-        throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) + " in both axes, got " +
-                                    std::to_string(width) + "x" + std::to_string(height));
+        throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) +
+                                    " in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions o = RenderOptions::from_scene(scene);
     o.width = width;

@@ -7,7 +7,7 @@
 namespace lpt {
 class Scene;
 class Vae;
-}
+}  // namespace lpt
 
 namespace lpt::pipeline {
 
@@ -18,8 +18,8 @@ float display_value(float v, const std::string& tone);
 /// Path-traced RGB of `scene` at width x height and `spp` (seed 0x5eed), display-mapped with
 /// `tone`, encoded by `vae`. `save_png` (if not empty) receives the display image, `display_rgb`
 /// (if given) its values. Throws if the size is not a multiple of the VAE's downsampling.
-std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone, const Vae& vae,
-                                        const std::string& save_png, std::vector<float>* display_rgb = nullptr,
-                                        const Reporter& report = {});
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone,
+                                        const Vae& vae, const std::string& save_png,
+                                        std::vector<float>* display_rgb = nullptr, const Reporter& report = {});
 
 }  // namespace lpt::pipeline

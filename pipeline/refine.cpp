@@ -35,10 +35,12 @@ Judges open_judges(const RefineJob& job, const Image& target, const Reporter& re
     const std::string lpips_dir = default_lpips_dir(job.lpips_dir);
     if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) j.lpips = Lpips::load(lpips_dir);
     if (!j.vae || !j.lpips)
-        report.say("note: no " + (j.vae ? "LPIPS weights in " + lpips_dir : "VAE (" + default_vae_dir(vae_source.dir) + ")") +
+        report.say("note: no " +
+                   (j.vae ? "LPIPS weights in " + lpips_dir : "VAE (" + default_vae_dir(vae_source.dir) + ")") +
                    ": refiner trains on latent MSE + SSIM only");
     j.path_traced = fs::exists(dir / "reference_rgb.exr");
-    if (j.path_traced) j.ref_rgb = read_fit_image((dir / "reference_rgb.exr").string(), 3, 8 * target.width, 8 * target.height).data;
+    if (j.path_traced)
+        j.ref_rgb = read_fit_image((dir / "reference_rgb.exr").string(), 3, 8 * target.width, 8 * target.height).data;
     else if (j.vae) j.ref_rgb = j.vae->decode(target.data, target.width, target.height);
     return j;
 }
@@ -61,28 +63,35 @@ nlohmann::json rgb_metrics(std::vector<float> rgb, const std::vector<float>& ref
     return j;
 }
 
-double latent_mse(const std::vector<float>& a, const std::vector<float>& b) { return mse_loss(a.data(), b.data(), a.size()); }
+double latent_mse(const std::vector<float>& a, const std::vector<float>& b) {
+    return mse_loss(a.data(), b.data(), a.size());
+}
 
 std::string refiner_csv(const RefinerTrainResult& res) {
     std::ostringstream csv;
     csv << "iteration,loss,smoothed_loss,mse,dssim,lpips,seconds\n";
     for (const RefinerRecord& r : res.history)
-        csv << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.mse << "," << r.dssim << "," << r.lpips << "," << r.seconds << "\n";
+        csv << r.iteration << "," << r.loss << "," << r.smoothed << "," << r.mse << "," << r.dssim << "," << r.lpips
+            << "," << r.seconds << "\n";
     return csv.str();
 }
 
 nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, const RefinerTrainResult& res) {
     const double seconds = res.history.empty() ? 0.0 : res.history.back().seconds;
-    return {{"expansion", job.net.expansion}, {"parameters", refiner.parameter_count()}, {"iterations", res.history.size()},
-            {"best_iteration", res.best_iteration}, {"seconds", seconds},
+    return {{"expansion", job.net.expansion},
+            {"parameters", refiner.parameter_count()},
+            {"iterations", res.history.size()},
+            {"best_iteration", res.best_iteration},
+            {"seconds", seconds},
             {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
-            {"crop", job.train.crop}, {"lpips_crop", job.train.lpips_crop}};
+            {"crop", job.train.crop},
+            {"lpips_crop", job.train.lpips_crop}};
 }
 
 /// metrics.json: latent MSE of the rendered and refined latents against the target, and with a
 /// VAE their decoded RGB errors and the VAE's own round trip; writes decoded_refined.png.
-nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vector<float>& refined, const Image& target,
-                     const Judges& j) {
+nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vector<float>& refined,
+                     const Image& target, const Judges& j) {
     nlohmann::json m = {{"rendered", {{"latent_mse", latent_mse(in.latent, target.data)}}},
                         {"refined", {{"latent_mse", latent_mse(refined, target.data)}}}};
     if (!j.vae || j.ref_rgb.empty()) return m;
@@ -91,7 +100,8 @@ nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vec
     m["rendered"].update(rgb_metrics(dec_rendered, j.ref_rgb, iw, ih, j.lpips.get()));
     m["refined"].update(rgb_metrics(dec_refined, j.ref_rgb, iw, ih, j.lpips.get()));
     if (j.path_traced)
-        m["vae_roundtrip"] = rgb_metrics(j.vae->decode(j.vae->encode(j.ref_rgb, iw, ih), w, h), j.ref_rgb, iw, ih, j.lpips.get());
+        m["vae_roundtrip"] =
+            rgb_metrics(j.vae->decode(j.vae->encode(j.ref_rgb, iw, ih), w, h), j.ref_rgb, iw, ih, j.lpips.get());
     m["reference"] = j.path_traced ? "reference_rgb.exr (path-traced RGB)" : "decoded target.exr";
     write_png_display((dir / "decoded_refined.png").string(), Image{iw, ih, 3, dec_refined, {}});
     return m;
@@ -99,7 +109,8 @@ nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vec
 
 std::string refine_status(const RefinerRecord& r) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "loss %.4f (smoothed %.4f; mse %.4f dssim %.4f lpips %.4f)", r.loss, r.smoothed, r.mse, r.dssim, r.lpips);
+    std::snprintf(buf, sizeof buf, "loss %.4f (smoothed %.4f; mse %.4f dssim %.4f lpips %.4f)", r.loss, r.smoothed,
+                  r.mse, r.dssim, r.lpips);
     return buf;
 }
 
@@ -130,11 +141,12 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         return !cancelled;
     };
     RefineSummary s;
-    s.result = refiner->train(in, target.data, judges.ref_rgb.empty() ? nullptr : &judges.ref_rgb, judges.vae.get(), judges.lpips.get(), o,
-                              on_iteration);
+    s.result = refiner->train(in, target.data, judges.ref_rgb.empty() ? nullptr : &judges.ref_rgb, judges.vae.get(),
+                              judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");
     char best[96];
-    std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss, s.result.best_iteration);
+    std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,
+                  s.result.best_iteration);
     report.say(best);
     refiner->save((dir / "refiner.pt").string());
 

@@ -19,8 +19,8 @@ struct RefineJob {
 
 struct RefineSummary {
     RefinerTrainResult result;
-    nlohmann::json metrics;     ///< what metrics.json holds: rendered / refined / vae_roundtrip
-    bool decoded = false;       ///< a VAE was found: decoded_refined.png written, RGB metrics present
+    nlohmann::json metrics;  ///< what metrics.json holds: rendered / refined / vae_roundtrip
+    bool decoded = false;    ///< a VAE was found: decoded_refined.png written, RGB metrics present
 };
 
 /// Throws Cancelled when the reporter cancels (refiner_checkpoint.pt keeps the last checkpoint).

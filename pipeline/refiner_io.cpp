@@ -38,11 +38,13 @@ RefinerInput load_refiner_input(const std::string& latent_exr, const std::string
     const char* names[4] = {"N.X", "N.Y", "N.Z", "Z"};
     for (int k = 0; k < 4; ++k) {
         auto it = std::find(aov.channel_names.begin(), aov.channel_names.end(), names[k]);
-        if (it == aov.channel_names.end()) throw std::runtime_error(aov_exr + ": no channel '" + names[k] + "' (expected N.X N.Y N.Z Z)");
+        if (it == aov.channel_names.end())
+            throw std::runtime_error(aov_exr + ": no channel '" + names[k] + "' (expected N.X N.Y N.Z Z)");
         idx[k] = int(it - aov.channel_names.begin());
     }
     for (size_t i = 0; i < size_t(lat.width) * lat.height; ++i) {
-        in.normal.insert(in.normal.end(), {aov.data[4 * i + idx[0]], aov.data[4 * i + idx[1]], aov.data[4 * i + idx[2]]});
+        in.normal.insert(in.normal.end(),
+                         {aov.data[4 * i + idx[0]], aov.data[4 * i + idx[1]], aov.data[4 * i + idx[2]]});
         in.distance.push_back(aov.data[4 * i + idx[3]]);
     }
     return in;

@@ -17,8 +17,8 @@ class Lpips;
 
 struct RefinerConfig {
     int latent_channels = 16;
-    int expansion = 16;          ///< hidden width = expansion × latent_channels
-    float squash = 3.f;          ///< inputs enter as tanh(x / squash); 3 = the TAESD decoder's soft clamp
+    int expansion = 16;  ///< hidden width = expansion × latent_channels
+    float squash = 3.f;  ///< inputs enter as tanh(x / squash); 3 = the TAESD decoder's soft clamp
     float dropout = 0.1f;
     float distance_scale = 1.f;  ///< distances are divided by this (the training view's mean hit distance)
 };
@@ -40,9 +40,9 @@ struct RefinerTrainOptions {
     int patience = 500;   ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
     uint64_t seed = 0;
-    int checkpoint_every = 100;  ///< 0 = only at the end
-    std::string checkpoint_path; ///< empty = no checkpoints
-    bool resume = false;         ///< continue from checkpoint_path
+    int checkpoint_every = 100;   ///< 0 = only at the end
+    std::string checkpoint_path;  ///< empty = no checkpoints
+    bool resume = false;          ///< continue from checkpoint_path
 };
 
 struct RefinerRecord {
@@ -73,8 +73,9 @@ public:
     /// `target_rgb` (8w × 8h × 3 in [0, 1]) when given, else with the decoded target; it needs
     /// `vae` (differentiable) and `lpips`, and is skipped when either is null. `on_iteration`
     /// returning false stops early. Ends with the best (smoothed-loss) weights loaded.
-    RefinerTrainResult train(const RefinerInput& input, const std::vector<float>& target, const std::vector<float>* target_rgb,
-                             const Vae* vae, const Lpips* lpips, const RefinerTrainOptions& options,
+    RefinerTrainResult train(const RefinerInput& input, const std::vector<float>& target,
+                             const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
+                             const RefinerTrainOptions& options,
                              const std::function<bool(const RefinerRecord&)>& on_iteration = {});
 
     const RefinerConfig& config() const;

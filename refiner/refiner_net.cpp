@@ -10,22 +10,27 @@ namespace lpt {
 
 namespace {
 
-torch::nn::Conv2d conv(int64_t in, int64_t out, int64_t k) { return torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, k).padding(k / 2)); }
+torch::nn::Conv2d conv(int64_t in, int64_t out, int64_t k) {
+    return torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, k).padding(k / 2));
+}
 
 void use_all_cores() { at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency()))); }
 
 }  // namespace
 
 RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
-    if (config.latent_channels < 1 || config.expansion < 1 || !(config.squash > 0.f) || !(config.dropout >= 0.f && config.dropout < 1.f) ||
-        !(config.distance_scale > 0.f))
-        throw std::invalid_argument("refiner: invalid configuration (channels, expansion >= 1; squash, distance scale > 0; dropout in [0, 1))");
+    if (config.latent_channels < 1 || config.expansion < 1 || !(config.squash > 0.f) ||
+        !(config.dropout >= 0.f && config.dropout < 1.f) || !(config.distance_scale > 0.f))
+        throw std::invalid_argument(
+            "refiner: invalid configuration (channels, expansion >= 1; squash, distance scale > 0; dropout in [0, 1))");
     const int64_t c = config.latent_channels, width = int64_t(config.expansion) * c;
     c1 = register_module("c1", conv(c + kRefinerAovChannels, width, 3));
     c2 = register_module("c2", conv(width, width, 5));
     c3 = register_module("c3", conv(width, width, 3));
     head = register_module("head", conv(width, c, 1));
-    auto norm = [&](const char* name) { return register_module(name, torch::nn::InstanceNorm2d(torch::nn::InstanceNorm2dOptions(width).affine(true))); };
+    auto norm = [&](const char* name) {
+        return register_module(name, torch::nn::InstanceNorm2d(torch::nn::InstanceNorm2dOptions(width).affine(true)));
+    };
     n1 = norm("n1");
     n2 = norm("n2");
     n3 = norm("n3");
@@ -44,12 +49,13 @@ torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& 
     const int64_t w = in.width, h = in.height, c = config.latent_channels, n = w * h;
     if (w < 1 || h < 1) throw std::invalid_argument("refiner: empty view");
     if (int64_t(in.latent.size()) != n * c || int64_t(in.normal.size()) != n * 3 || int64_t(in.distance.size()) != n)
-        throw std::invalid_argument("refiner: a " + std::to_string(w) + "x" + std::to_string(h) + " view needs " + std::to_string(c) +
-                                    " latent, 3 normal and 1 distance channels per pixel");
+        throw std::invalid_argument("refiner: a " + std::to_string(w) + "x" + std::to_string(h) + " view needs " +
+                                    std::to_string(c) + " latent, 3 normal and 1 distance channels per pixel");
     auto nchw = [&](const std::vector<float>& v, int64_t ch) {
         return torch::from_blob(const_cast<float*>(v.data()), {1, h, w, ch}).permute({0, 3, 1, 2});
     };
-    return torch::cat({nchw(in.latent, c), nchw(in.normal, 3), nchw(in.distance, 1) / config.distance_scale}, 1).contiguous();
+    return torch::cat({nchw(in.latent, c), nchw(in.normal, 3), nchw(in.distance, 1) / config.distance_scale}, 1)
+        .contiguous();
 }
 
 std::vector<float> refiner_to_hwc(const torch::Tensor& nchw) {
@@ -107,7 +113,8 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         ar.load_from(path);
         auto get = [&](const char* key) {
             c10::IValue v;
-            if (!ar.try_read(key, v)) throw std::runtime_error(path + ": not a latentpt refiner (no '" + std::string(key) + "')");
+            if (!ar.try_read(key, v))
+                throw std::runtime_error(path + ": not a latentpt refiner (no '" + std::string(key) + "')");
             return v;
         };
         RefinerConfig c;

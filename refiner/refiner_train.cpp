@@ -49,11 +49,14 @@ struct TrainingState {
     double smoothed = 0;
 
     TrainingState(RefinerNet& net, const RefinerTrainOptions& o)
-        : adam(net->parameters(), torch::optim::AdamOptions(o.lr)), stop(std::max(1, o.patience), o.min_delta), best(copy_params(*net)) {}
+        : adam(net->parameters(), torch::optim::AdamOptions(o.lr)),
+          stop(std::max(1, o.patience), o.min_delta),
+          best(copy_params(*net)) {}
 };
 
 void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, TrainingState& s) {
-    if (path.empty() || !std::filesystem::exists(path)) throw std::runtime_error("refiner: --resume but no checkpoint at '" + path + "'");
+    if (path.empty() || !std::filesystem::exists(path))
+        throw std::runtime_error("refiner: --resume but no checkpoint at '" + path + "'");
     try {
         torch::serialize::InputArchive ar, net_ar, best_ar, adam_ar;
         ar.load_from(path);
@@ -71,8 +74,9 @@ void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
         ar.read("history", hist);
         for (int64_t i = 0; i < hist.size(0); ++i) {
             auto r = hist[i];
-            s.result.history.push_back({int(r[0].item<double>()), r[1].item<double>(), r[2].item<double>(), r[3].item<double>(),
-                                        r[4].item<double>(), r[5].item<double>(), r[6].item<double>()});
+            s.result.history.push_back({int(r[0].item<double>()), r[1].item<double>(), r[2].item<double>(),
+                                        r[3].item<double>(), r[4].item<double>(), r[5].item<double>(),
+                                        r[6].item<double>()});
         }
         torch::Tensor st;
         ar.read("stop", st);
@@ -103,7 +107,8 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
         for (int k = 0; k < 7; ++k) hist[int64_t(i)][k] = v[k];
     }
     ar.write("history", hist);
-    ar.write("stop", torch::tensor({s.stop.best_loss(), double(s.stop.best_iteration()), double(s.stop.bad_updates())}, torch::kFloat64));
+    ar.write("stop", torch::tensor({s.stop.best_loss(), double(s.stop.best_iteration()), double(s.stop.bad_updates())},
+                                   torch::kFloat64));
     const std::string tmp_path = path + ".tmp";
     ar.save_to(tmp_path);
     std::filesystem::rename(tmp_path, path);
@@ -119,18 +124,23 @@ struct TrainingData {
 };
 
 TrainingData training_data(const RefinerInput& input, const RefinerConfig& cfg, const std::vector<float>& target,
-                           const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips, const RefinerTrainOptions& o) {
+                           const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
+                           const RefinerTrainOptions& o) {
     TrainingData d;
     d.w = input.width;
     d.h = input.height;
     const int w = d.w, h = d.h, c = cfg.latent_channels;
     d.x_all = refiner_input_tensor(input, cfg);
     if (int64_t(target.size()) != int64_t(w) * h * c)
-        throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c));
+        throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" + std::to_string(h) +
+                                    "x" + std::to_string(c));
     d.y_all = torch::from_blob(const_cast<float*>(target.data()), {1, h, w, c}).permute({0, 3, 1, 2}).contiguous();
     if (target_rgb) {
-        if (int64_t(target_rgb->size()) != int64_t(64) * w * h * 3) throw std::invalid_argument("refiner: target RGB must be 8w x 8h x 3");
-        d.rgb_all = torch::from_blob(const_cast<float*>(target_rgb->data()), {1, 8 * h, 8 * w, 3}).permute({0, 3, 1, 2}).contiguous();
+        if (int64_t(target_rgb->size()) != int64_t(64) * w * h * 3)
+            throw std::invalid_argument("refiner: target RGB must be 8w x 8h x 3");
+        d.rgb_all = torch::from_blob(const_cast<float*>(target_rgb->data()), {1, 8 * h, 8 * w, 3})
+                        .permute({0, 3, 1, 2})
+                        .contiguous();
     }
     d.vae = vae ? torch_vae(*vae) : nullptr;
     d.lpips = lpips;
@@ -144,7 +154,8 @@ TrainingData training_data(const RefinerInput& input, const RefinerConfig& cfg, 
 
 /// Iteration `it`'s loss on its crop (w·MSE + w·D-SSIM + w·LPIPS of a decoded sub-crop); the
 /// record receives the parts.
-torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTrainOptions& o, int it, RefinerRecord& r) {
+torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTrainOptions& o, int it,
+                        RefinerRecord& r) {
     const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
     torch::manual_seed(key);  // dropout masks
     const int cx = pick(key + 1, d.w - d.crop_w), cy = pick(key + 2, d.h - d.crop_h);
@@ -180,8 +191,9 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
 
 }  // namespace
 
-RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<float>& target, const std::vector<float>* target_rgb,
-                                  const Vae* vae, const Lpips* lpips, const RefinerTrainOptions& o,
+RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<float>& target,
+                                  const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
+                                  const RefinerTrainOptions& o,
                                   const std::function<bool(const RefinerRecord&)>& on_iteration) {
     RefinerNet& net = m->net;
     const RefinerConfig& cfg = m->config;
@@ -196,7 +208,8 @@ RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<f
         s.adam.zero_grad();
         RefinerRecord r;
         torch::Tensor loss = crop_loss(net, data, o, it, r);
-        if (!std::isfinite(r.loss)) throw std::runtime_error("refiner: loss became non-finite at iteration " + std::to_string(it));
+        if (!std::isfinite(r.loss))
+            throw std::runtime_error("refiner: loss became non-finite at iteration " + std::to_string(it));
         loss.backward();
         s.adam.step();
         s.smoothed = it == 0 ? r.loss : kSmoothing * s.smoothed + (1 - kSmoothing) * r.loss;
@@ -206,7 +219,8 @@ RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<f
         const bool should_stop = s.stop.update(s.smoothed, it);
         if (s.stop.improved()) s.best = copy_params(*net);
         if (o.patience > 0 && should_stop) stopped = true;
-        if (o.checkpoint_every > 0 && (it + 1) % o.checkpoint_every == 0) save_checkpoint(o.checkpoint_path, net, cfg, s);
+        if (o.checkpoint_every > 0 && (it + 1) % o.checkpoint_every == 0)
+            save_checkpoint(o.checkpoint_path, net, cfg, s);
         if (on_iteration && !on_iteration(r)) break;
     }
     save_checkpoint(o.checkpoint_path, net, cfg, s);

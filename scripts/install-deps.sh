@@ -5,6 +5,7 @@
 #  - libopenblas0-pthread: otherwise libtorch matrix products fall back to reference BLAS.
 #  - python3-torch: only for tools/export_*.py (TorchScript VAEs) and the test that exports
 #    TAESD3 and checks the TorchScript path against the native one.
+#  - clang-format-14: the format check in ctest (.clang-format).
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build ccache pkg-config
@@ -14,6 +15,7 @@ pkgs=(
   libtinygltf-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libcli11-dev
   libgtest-dev libbenchmark-dev
   python3-torch
+  clang-format-14
 )
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi

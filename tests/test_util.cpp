@@ -12,7 +12,8 @@ namespace {
 /// latentpt-test-<pid> in the system's temp folder, removed at process exit.
 class ProcessTempDir {
 public:
-    ProcessTempDir() : m_path(std::filesystem::temp_directory_path() / ("latentpt-test-" + std::to_string(::getpid()))) {}
+    ProcessTempDir()
+        : m_path(std::filesystem::temp_directory_path() / ("latentpt-test-" + std::to_string(::getpid()))) {}
     ~ProcessTempDir() {
         std::error_code ignored;
         std::filesystem::remove_all(m_path, ignored);

@@ -21,8 +21,8 @@ struct FireSpec {
     int64_t in, squeeze, expand;
 };
 // features.{3,4,6,7,9,10,11,12}: Fire(in -> squeeze -> expand + expand)
-constexpr FireSpec kFires[] = {{3, 64, 16, 64},    {4, 128, 16, 64},   {6, 128, 32, 128},  {7, 256, 32, 128},
-                               {9, 256, 48, 192},  {10, 384, 48, 192}, {11, 384, 64, 256}, {12, 512, 64, 256}};
+constexpr FireSpec kFires[] = {{3, 64, 16, 64},   {4, 128, 16, 64},   {6, 128, 32, 128},  {7, 256, 32, 128},
+                               {9, 256, 48, 192}, {10, 384, 48, 192}, {11, 384, 64, 256}, {12, 512, 64, 256}};
 
 using Expected = std::vector<std::pair<std::string, std::vector<int64_t>>>;
 
@@ -39,7 +39,8 @@ Expected expected_tensors() {
         e.push_back({p + "expand3x3.weight", {f.expand, f.squeeze, 3, 3}});
         e.push_back({p + "expand3x3.bias", {f.expand}});
     }
-    for (int k = 0; k < Lpips::kLayers; ++k) e.push_back({"lin." + std::to_string(k) + ".weight", {1, kTapChannels[k], 1, 1}});
+    for (int k = 0; k < Lpips::kLayers; ++k)
+        e.push_back({"lin." + std::to_string(k) + ".weight", {1, kTapChannels[k], 1, 1}});
     e.push_back({"scaling.shift", {1, 3, 1, 1}});
     e.push_back({"scaling.scale", {1, 3, 1, 1}});
     return e;
@@ -50,20 +51,23 @@ torch::Tensor like(const torch::Tensor& t, const torch::Tensor& x) {
     return (t.scalar_type() == x.scalar_type() && t.device() == x.device()) ? t : t.to(x.options());
 }
 
-torch::Tensor conv(const LpipsNet& n, const std::string& name, const torch::Tensor& x, int64_t stride, int64_t padding) {
+torch::Tensor conv(const LpipsNet& n, const std::string& name, const torch::Tensor& x, int64_t stride,
+                   int64_t padding) {
     return torch::conv2d(x, like(n.w.at(name + ".weight"), x), like(n.w.at(name + ".bias"), x), stride, padding);
 }
 
 torch::Tensor fire(const LpipsNet& n, int idx, const torch::Tensor& x) {
     const std::string p = "features." + std::to_string(idx) + ".";
     torch::Tensor s = torch::relu(conv(n, p + "squeeze", x, 1, 0));
-    return torch::cat({torch::relu(conv(n, p + "expand1x1", s, 1, 0)), torch::relu(conv(n, p + "expand3x3", s, 1, 1))}, 1);
+    return torch::cat({torch::relu(conv(n, p + "expand1x1", s, 1, 0)), torch::relu(conv(n, p + "expand3x3", s, 1, 1))},
+                      1);
 }
 
 torch::Tensor pool(const torch::Tensor& x) {
     if (x.size(2) < 2 || x.size(3) < 2)
         throw std::invalid_argument("LPIPS: the image is too small for the SqueezeNet backbone (needs at least " +
-                                    std::to_string(Lpips::kMinSize) + "x" + std::to_string(Lpips::kMinSize) + " pixels)");
+                                    std::to_string(Lpips::kMinSize) + "x" + std::to_string(Lpips::kMinSize) +
+                                    " pixels)");
     return torch::max_pool2d(x, {3, 3}, {2, 2}, {0, 0}, {1, 1}, /*ceil_mode=*/true);
 }
 
@@ -99,25 +103,26 @@ std::array<torch::Tensor, Lpips::kLayers> taps(const LpipsNet& n, const torch::T
 torch::Tensor unit_normalise(const torch::Tensor& f) {
     torch::Tensor s = (f * f).sum(1, /*keepdim=*/true);
     torch::Tensor pos = s > 0;
-    torch::Tensor norm = torch::where(pos, torch::sqrt(torch::where(pos, s, torch::ones_like(s))), torch::zeros_like(s));
+    torch::Tensor norm =
+        torch::where(pos, torch::sqrt(torch::where(pos, s, torch::ones_like(s))), torch::zeros_like(s));
     return f / (norm + 1e-10);
 }
 
 void check_inputs(const torch::Tensor& a, const torch::Tensor& b) {
     if (a.dim() != 4 || a.size(1) != 3 || a.sizes() != b.sizes())
-        throw std::invalid_argument("lpips_torch: expects two NCHW RGB tensors of the same shape, got " + c10::str(a.sizes()) + " and " +
-                                    c10::str(b.sizes()));
+        throw std::invalid_argument("lpips_torch: expects two NCHW RGB tensors of the same shape, got " +
+                                    c10::str(a.sizes()) + " and " + c10::str(b.sizes()));
     if (a.size(2) < Lpips::kMinSize || a.size(3) < Lpips::kMinSize)
         throw std::invalid_argument("LPIPS: image " + std::to_string(a.size(3)) + "x" + std::to_string(a.size(2)) +
-                                    " is too small for the SqueezeNet backbone (needs at least " + std::to_string(Lpips::kMinSize) + "x" +
-                                    std::to_string(Lpips::kMinSize) + ")");
+                                    " is too small for the SqueezeNet backbone (needs at least " +
+                                    std::to_string(Lpips::kMinSize) + "x" + std::to_string(Lpips::kMinSize) + ")");
 }
 
 /// Interleaved RGB in [0, 1] -> NCHW in [-1, 1].
 torch::Tensor to_nchw(const std::vector<float>& rgb, int width, int height, const char* which) {
     if (width <= 0 || height <= 0 || rgb.size() != size_t(width) * height * 3)
-        throw std::invalid_argument(std::string("LPIPS: image ") + which + " has " + std::to_string(rgb.size()) + " floats, expected " +
-                                    std::to_string(width) + "x" + std::to_string(height) + "x3");
+        throw std::invalid_argument(std::string("LPIPS: image ") + which + " has " + std::to_string(rgb.size()) +
+                                    " floats, expected " + std::to_string(width) + "x" + std::to_string(height) + "x3");
     return torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2}) * 2.0 - 1.0;
 }
 
@@ -134,8 +139,8 @@ LpipsNet load_lpips_net(const std::string& dir) {
         n.w[key] = torch::from_blob(v.data(), shape, torch::kFloat32).clone();
     }
     if (st.tensors().size() != expected.size())
-        throw std::runtime_error(n.path + ": " + std::to_string(st.tensors().size()) + " tensors, expected " + std::to_string(expected.size()) +
-                                 " (not the LPIPS-squeeze v0.1 file?)");
+        throw std::runtime_error(n.path + ": " + std::to_string(st.tensors().size()) + " tensors, expected " +
+                                 std::to_string(expected.size()) + " (not the LPIPS-squeeze v0.1 file?)");
     n.shift = n.w.at("scaling.shift");
     n.scale = n.w.at("scaling.scale");
     for (int k = 0; k < Lpips::kLayers; ++k) n.lin[k] = n.w.at("lin." + std::to_string(k) + ".weight");
@@ -171,9 +176,11 @@ std::unique_ptr<Lpips> Lpips::load(const std::string& dir) {
 
 const std::string& Lpips::path() const { return m_net->path; }
 
-std::vector<double> Lpips::layer_distances(const std::vector<float>& rgb_a, const std::vector<float>& rgb_b, int width, int height) const {
+std::vector<double> Lpips::layer_distances(const std::vector<float>& rgb_a, const std::vector<float>& rgb_b, int width,
+                                           int height) const {
     torch::NoGradGuard no_grad;
-    torch::Tensor l = lpips_torch_layers(*m_net, to_nchw(rgb_a, width, height, "a"), to_nchw(rgb_b, width, height, "b"));
+    torch::Tensor l =
+        lpips_torch_layers(*m_net, to_nchw(rgb_a, width, height, "a"), to_nchw(rgb_b, width, height, "b"));
     std::vector<double> out(kLayers);
     for (int k = 0; k < kLayers; ++k) out[k] = l[0][k].item<double>();
     return out;
@@ -181,7 +188,8 @@ std::vector<double> Lpips::layer_distances(const std::vector<float>& rgb_a, cons
 
 double Lpips::distance(const std::vector<float>& rgb_a, const std::vector<float>& rgb_b, int width, int height) const {
     torch::NoGradGuard no_grad;
-    return lpips_torch(*m_net, to_nchw(rgb_a, width, height, "a"), to_nchw(rgb_b, width, height, "b"))[0].item<double>();
+    return lpips_torch(*m_net, to_nchw(rgb_a, width, height, "a"), to_nchw(rgb_b, width, height, "b"))[0]
+        .item<double>();
 }
 
 }  // namespace lpt

@@ -27,7 +27,8 @@ public:
     /// symmetric. Throws std::invalid_argument on wrong buffer sizes or images under kMinSize.
     double distance(const std::vector<float>& rgb_a, const std::vector<float>& rgb_b, int width, int height) const;
     /// The 7 per-layer terms whose sum is distance().
-    std::vector<double> layer_distances(const std::vector<float>& rgb_a, const std::vector<float>& rgb_b, int width, int height) const;
+    std::vector<double> layer_distances(const std::vector<float>& rgb_a, const std::vector<float>& rgb_b, int width,
+                                        int height) const;
 
     /// The network, for code that includes vae/lpips_torch.h (e.g. a training loss).
     const LpipsNet& net() const { return *m_net; }

@@ -12,9 +12,9 @@
 namespace lpt {
 
 struct LpipsNet {
-    std::string path;                         ///< the safetensors file
-    std::map<std::string, torch::Tensor> w;   ///< backbone, torchvision names (features.N.*)
-    torch::Tensor shift, scale;               ///< scaling layer, [1, 3, 1, 1]
+    std::string path;                               ///< the safetensors file
+    std::map<std::string, torch::Tensor> w;         ///< backbone, torchvision names (features.N.*)
+    torch::Tensor shift, scale;                     ///< scaling layer, [1, 3, 1, 1]
     std::array<torch::Tensor, Lpips::kLayers> lin;  ///< linear heads, [1, C_k, 1, 1], no bias
 };
 

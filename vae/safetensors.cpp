@@ -60,7 +60,9 @@ SafeTensors SafeTensors::parse(std::string bytes, const std::string& name) {
     if (bytes.size() < 8) fail(name, "truncated: shorter than the 8-byte header length");
     uint64_t n = 0;
     for (int i = 7; i >= 0; --i) n = (n << 8) | uint8_t(bytes[i]);
-    if (n > bytes.size() - 8) fail(name, "truncated: header length " + std::to_string(n) + " exceeds the file (" + std::to_string(bytes.size()) + " bytes)");
+    if (n > bytes.size() - 8)
+        fail(name, "truncated: header length " + std::to_string(n) + " exceeds the file (" +
+                       std::to_string(bytes.size()) + " bytes)");
     nlohmann::json h;
     try {
         h = nlohmann::json::parse(bytes.begin() + 8, bytes.begin() + 8 + long(n));
@@ -89,7 +91,8 @@ SafeTensors SafeTensors::parse(std::string bytes, const std::string& name) {
         else fail(name, where + ": unsupported dtype '" + dt + "' (supported: F32, F16, BF16)");
         if (!v["shape"].is_array()) fail(name, where + ": shape is not an array");
         for (const auto& d : v["shape"]) {
-            if (!d.is_number_integer() || d.get<int64_t>() < 0) fail(name, where + ": shape entries must be non-negative integers");
+            if (!d.is_number_integer() || d.get<int64_t>() < 0)
+                fail(name, where + ": shape entries must be non-negative integers");
             t.shape.push_back(d.get<int64_t>());
         }
         const auto& off = v["data_offsets"];
@@ -98,11 +101,12 @@ SafeTensors SafeTensors::parse(std::string bytes, const std::string& name) {
         t.begin = off[0].get<size_t>();
         t.end = off[1].get<size_t>();
         if (t.begin > t.end || t.end > data_size)
-            fail(name, where + ": data_offsets [" + std::to_string(t.begin) + ", " + std::to_string(t.end) + "] outside the " +
-                           std::to_string(data_size) + "-byte data section (truncated file?)");
+            fail(name, where + ": data_offsets [" + std::to_string(t.begin) + ", " + std::to_string(t.end) +
+                           "] outside the " + std::to_string(data_size) + "-byte data section (truncated file?)");
         if (uint64_t(t.numel()) * dtype_size(t.dtype) != t.end - t.begin)
-            fail(name, where + ": shape " + shape_string(t.shape) + " of " + dt + " needs " + std::to_string(t.numel() * dtype_size(t.dtype)) +
-                           " bytes, data_offsets give " + std::to_string(t.end - t.begin));
+            fail(name, where + ": shape " + shape_string(t.shape) + " of " + dt + " needs " +
+                           std::to_string(t.numel() * dtype_size(t.dtype)) + " bytes, data_offsets give " +
+                           std::to_string(t.end - t.begin));
         ranges.emplace_back(t.begin, t.end);
         st.m_tensors[key] = t;
     }
@@ -118,7 +122,8 @@ std::vector<float> SafeTensors::to_float(const std::string& tensor, const std::v
     if (it == m_tensors.end()) fail(m_path, "no tensor '" + tensor + "'");
     const TensorInfo& t = it->second;
     if (!expected_shape.empty() && expected_shape != t.shape)
-        fail(m_path, "tensor '" + tensor + "' has shape " + shape_string(t.shape) + ", expected " + shape_string(expected_shape));
+        fail(m_path, "tensor '" + tensor + "' has shape " + shape_string(t.shape) + ", expected " +
+                         shape_string(expected_shape));
     std::vector<float> out(size_t(t.numel()));
     const char* p = m_bytes.data() + m_data_start + t.begin;
     for (size_t i = 0; i < out.size(); ++i) {

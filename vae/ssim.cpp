@@ -29,8 +29,10 @@ void check_args(int w, int h, int channels, double data_range, const char* who) 
     if (w < kSsimWindow || h < kSsimWindow)
         throw std::invalid_argument(std::string(who) + ": image " + std::to_string(w) + "x" + std::to_string(h) +
                                     " is smaller than the 11x11 window");
-    if (channels < 1) throw std::invalid_argument(std::string(who) + ": channels must be >= 1, got " + std::to_string(channels));
-    if (!(data_range > 0)) throw std::invalid_argument(std::string(who) + ": data_range must be > 0, got " + std::to_string(data_range));
+    if (channels < 1)
+        throw std::invalid_argument(std::string(who) + ": channels must be >= 1, got " + std::to_string(channels));
+    if (!(data_range > 0))
+        throw std::invalid_argument(std::string(who) + ": data_range must be > 0, got " + std::to_string(data_range));
 }
 
 }  // namespace
@@ -66,7 +68,8 @@ double ssim(const float* a, const float* b, int w, int h, int channels, double d
                     for (int q = 0; q < 5; ++q) m[q] += g[k] * rows[(size_t(q) * h + y + k) * ow + x];
                 const double mu_a = m[0], mu_b = m[1];
                 const double var_a = m[2] - mu_a * mu_a, var_b = m[3] - mu_b * mu_b, cov = m[4] - mu_a * mu_b;
-                sum += ((2 * mu_a * mu_b + c1) * (2 * cov + c2)) / ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
+                sum += ((2 * mu_a * mu_b + c1) * (2 * cov + c2)) /
+                       ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
             }
         total += sum / (double(ow) * oh);
     }
@@ -75,8 +78,8 @@ double ssim(const float* a, const float* b, int w, int h, int channels, double d
 
 torch::Tensor ssim_torch(const torch::Tensor& a, const torch::Tensor& b, double data_range) {
     if (a.dim() != 4 || a.sizes() != b.sizes())
-        throw std::invalid_argument("ssim_torch: expects two NCHW tensors of the same shape, got " + c10::str(a.sizes()) + " and " +
-                                    c10::str(b.sizes()));
+        throw std::invalid_argument("ssim_torch: expects two NCHW tensors of the same shape, got " +
+                                    c10::str(a.sizes()) + " and " + c10::str(b.sizes()));
     const int64_t ch = a.size(1);
     check_args(int(a.size(3)), int(a.size(2)), int(ch), data_range, "ssim_torch");
     const std::vector<double> taps = gaussian_taps();
@@ -85,15 +88,18 @@ torch::Tensor ssim_torch(const torch::Tensor& a, const torch::Tensor& b, double 
     torch::Tensor gh = g.view({1, 1, 1, kSsimWindow}).expand({ch, 1, 1, kSsimWindow}).contiguous();
     torch::Tensor gv = g.view({1, 1, kSsimWindow, 1}).expand({ch, 1, kSsimWindow, 1}).contiguous();
     auto filt = [&](const torch::Tensor& x) {
-        torch::Tensor y = torch::conv2d(x, gh, torch::Tensor(), /*stride=*/{1, 1}, /*padding=*/torch::IntArrayRef{0, 0}, /*dilation=*/{1, 1}, /*groups=*/ch);
-        return torch::conv2d(y, gv, torch::Tensor(), /*stride=*/{1, 1}, /*padding=*/torch::IntArrayRef{0, 0}, /*dilation=*/{1, 1}, /*groups=*/ch);
+        torch::Tensor y = torch::conv2d(x, gh, torch::Tensor(), /*stride=*/{1, 1}, /*padding=*/torch::IntArrayRef{0, 0},
+                                        /*dilation=*/{1, 1}, /*groups=*/ch);
+        return torch::conv2d(y, gv, torch::Tensor(), /*stride=*/{1, 1}, /*padding=*/torch::IntArrayRef{0, 0},
+                             /*dilation=*/{1, 1}, /*groups=*/ch);
     };
     const double c1 = (0.01 * data_range) * (0.01 * data_range), c2 = (0.03 * data_range) * (0.03 * data_range);
     torch::Tensor mu_a = filt(a), mu_b = filt(b);
     torch::Tensor var_a = filt(a * a) - mu_a * mu_a;
     torch::Tensor var_b = filt(b * b) - mu_b * mu_b;
     torch::Tensor cov_ab = filt(a * b) - mu_a * mu_b;
-    torch::Tensor map = ((2 * mu_a * mu_b + c1) * (2 * cov_ab + c2)) / ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
+    torch::Tensor map =
+        ((2 * mu_a * mu_b + c1) * (2 * cov_ab + c2)) / ((mu_a * mu_a + mu_b * mu_b + c1) * (var_a + var_b + c2));
     return map.mean({2, 3}).mean(1);
 }
 

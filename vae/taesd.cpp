@@ -19,7 +19,8 @@ struct Weights {
     const torch::Tensor& operator[](const std::string& k) const { return t.at(k); }
 };
 
-Weights load_weights(const std::string& path, const std::vector<std::pair<std::string, std::vector<int64_t>>>& expected) {
+Weights load_weights(const std::string& path,
+                     const std::vector<std::pair<std::string, std::vector<int64_t>>>& expected) {
     SafeTensors st = SafeTensors::load(path);
     Weights w;
     for (const auto& [key, shape] : expected) {
@@ -28,14 +29,15 @@ Weights load_weights(const std::string& path, const std::vector<std::pair<std::s
         w.t[key] = torch::from_blob(v.data(), shape, torch::kFloat32).clone();
     }
     if (st.tensors().size() != expected.size())
-        throw std::runtime_error(path + ": " + std::to_string(st.tensors().size()) + " tensors, expected " + std::to_string(expected.size()) +
-                                 " (not a TAESD file?)");
+        throw std::runtime_error(path + ": " + std::to_string(st.tensors().size()) + " tensors, expected " +
+                                 std::to_string(expected.size()) + " (not a TAESD file?)");
     return w;
 }
 
 constexpr int64_t kC = 64;  // every internal width
 
-void expect_conv(std::vector<std::pair<std::string, std::vector<int64_t>>>& e, const std::string& name, int64_t out, int64_t in, bool bias) {
+void expect_conv(std::vector<std::pair<std::string, std::vector<int64_t>>>& e, const std::string& name, int64_t out,
+                 int64_t in, bool bias) {
     e.push_back({name + ".weight", {out, in, 3, 3}});
     if (bias) e.push_back({name + ".bias", {out}});
 }

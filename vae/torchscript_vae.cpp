@@ -55,11 +55,14 @@ public:
             m_conv.scale = field("scale").get<float>();
             m_conv.shift = field("shift").get<float>();
             const auto range = field("image_range").get<std::vector<float>>();
-            if (range.size() != 2 || !(range[1] > range[0])) throw std::runtime_error(config + ": field 'image_range' must be [low, high] with low < high");
+            if (range.size() != 2 || !(range[1] > range[0]))
+                throw std::runtime_error(config + ": field 'image_range' must be [low, high] with low < high");
             m_lo = range[0];
             m_hi = range[1];
             const std::string latent = field("latent").get<std::string>();
-            if (latent != "raw" && latent != "model") throw std::runtime_error(config + ": field 'latent' must be \"raw\" or \"model\", got \"" + latent + "\"");
+            if (latent != "raw" && latent != "model")
+                throw std::runtime_error(config + ": field 'latent' must be \"raw\" or \"model\", got \"" + latent +
+                                         "\"");
             m_raw = latent == "raw";
         } catch (const nlohmann::json::exception& e) {
             throw std::runtime_error(config + ": wrong type of a field: " + e.what());
@@ -76,9 +79,11 @@ public:
     torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {
         torch::Tensor z = run(m_enc, m_encoder_path, rgb * (m_hi - m_lo) + m_lo);
         const int f = m_conv.downsample;
-        if (z.dim() != 4 || z.size(1) != m_conv.channels || z.size(2) * f != rgb.size(2) || z.size(3) * f != rgb.size(3))
-            throw std::runtime_error(m_encoder_path + ": encoder returned " + shape_of(z) + " for an image " + shape_of(rgb) +
-                                     "; the config says " + std::to_string(m_conv.channels) + " channels at 1/" + std::to_string(f));
+        if (z.dim() != 4 || z.size(1) != m_conv.channels || z.size(2) * f != rgb.size(2) ||
+            z.size(3) * f != rgb.size(3))
+            throw std::runtime_error(m_encoder_path + ": encoder returned " + shape_of(z) + " for an image " +
+                                     shape_of(rgb) + "; the config says " + std::to_string(m_conv.channels) +
+                                     " channels at 1/" + std::to_string(f));
         return m_raw ? (z - m_conv.shift) * m_conv.scale : z;
     }
 
@@ -86,7 +91,8 @@ public:
         torch::Tensor x = run(m_dec, m_decoder_path, m_raw ? latent / m_conv.scale + m_conv.shift : latent);
         const int f = m_conv.downsample;
         if (x.dim() != 4 || x.size(1) != 3 || x.size(2) != latent.size(2) * f || x.size(3) != latent.size(3) * f)
-            throw std::runtime_error(m_decoder_path + ": decoder returned " + shape_of(x) + " for a latent " + shape_of(latent));
+            throw std::runtime_error(m_decoder_path + ": decoder returned " + shape_of(x) + " for a latent " +
+                                     shape_of(latent));
         return (x - m_lo) / (m_hi - m_lo);
     }
 
@@ -112,7 +118,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Vae> load_torchscript_vae(const std::string& encoder, const std::string& decoder, const std::string& config) {
+std::unique_ptr<Vae> load_torchscript_vae(const std::string& encoder, const std::string& decoder,
+                                          const std::string& config) {
     return std::make_unique<TorchScriptVae>(encoder, decoder, config);
 }
 

@@ -11,8 +11,8 @@ namespace lpt {
 
 struct LatentConvention {
     int channels = 16;
-    int downsample = 8;    ///< image pixels per latent pixel, per axis
-    float scale = 1.5305f; ///< model latent = (raw VAE latent − shift) · scale
+    int downsample = 8;     ///< image pixels per latent pixel, per axis
+    float scale = 1.5305f;  ///< model latent = (raw VAE latent − shift) · scale
     float shift = 0.0609f;
 };
 
@@ -36,6 +36,7 @@ std::unique_ptr<Vae> load_taesd(const std::string& dir, const std::string& prefi
 /// A VAE exported as TorchScript: `encoder` and `decoder` modules and `config` (vae.json: channels,
 /// downsample, scale, shift, image_range, latent "raw" | "model"; docs/vae.md). Throws
 /// std::runtime_error naming the file and field on a missing file, a bad module or config.
-std::unique_ptr<Vae> load_torchscript_vae(const std::string& encoder, const std::string& decoder, const std::string& config);
+std::unique_ptr<Vae> load_torchscript_vae(const std::string& encoder, const std::string& decoder,
+                                          const std::string& config);
 
 }  // namespace lpt

@@ -26,19 +26,25 @@ public:
     std::vector<float> encode(const std::vector<float>& rgb, int width, int height) const final {
         const int f = convention().downsample;
         if (width % f || height % f)
-            throw std::invalid_argument("encode: image " + std::to_string(width) + "x" + std::to_string(height) + " is not a multiple of " +
-                                        std::to_string(f) + " in both axes (crop or pad it first)");
-        if (rgb.size() != size_t(width) * height * 3) throw std::invalid_argument("encode: expected width*height*3 floats");
+            throw std::invalid_argument("encode: image " + std::to_string(width) + "x" + std::to_string(height) +
+                                        " is not a multiple of " + std::to_string(f) +
+                                        " in both axes (crop or pad it first)");
+        if (rgb.size() != size_t(width) * height * 3)
+            throw std::invalid_argument("encode: expected width*height*3 floats");
         torch::NoGradGuard no_grad;
-        return to_hwc(encode_nchw(torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3}).permute({0, 3, 1, 2}).contiguous()));
+        return to_hwc(encode_nchw(torch::from_blob(const_cast<float*>(rgb.data()), {1, height, width, 3})
+                                      .permute({0, 3, 1, 2})
+                                      .contiguous()));
     }
     std::vector<float> decode(const std::vector<float>& latent, int width, int height) const final {
         const int c = convention().channels;
         if (latent.size() != size_t(width) * height * c)
-            throw std::invalid_argument("decode: expected " + std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(c) +
-                                        " floats, got " + std::to_string(latent.size()));
+            throw std::invalid_argument("decode: expected " + std::to_string(width) + "x" + std::to_string(height) +
+                                        "x" + std::to_string(c) + " floats, got " + std::to_string(latent.size()));
         torch::NoGradGuard no_grad;
-        return to_hwc(decode_nchw(torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c}).permute({0, 3, 1, 2}).contiguous()));
+        return to_hwc(decode_nchw(torch::from_blob(const_cast<float*>(latent.data()), {1, height, width, c})
+                                      .permute({0, 3, 1, 2})
+                                      .contiguous()));
     }
 
 private:

@@ -35,7 +35,9 @@ public:
     uint32_t flags() const override { return kDeltaReflection; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_specular * m_ior.fresnel(1.f); }
 
-    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f&, const Vec3f&, int) const override { return Spectrum<N>::Zero(); }
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f&, const Vec3f&, int) const override {
+        return Spectrum<N>::Zero();
+    }
     Spectrum<N> weight_grad(const BSDFContext&, const Vec3f& wi, const BSDFSample<N>&, int) const override {
         return Spectrum<N>::Ones() * m_ior.fresnel(cos_theta(wi));  // d/dR of (14)
     }

@@ -47,7 +47,9 @@ public:
     uint32_t flags() const override { return kDeltaReflection | kDeltaTransmission; }
     Spectrum<N> albedo(const BSDFContext&) const override { return m_transmittance; }
 
-    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f&, const Vec3f&, int) const override { return Spectrum<N>::Zero(); }
+    Spectrum<N> eval_grad(const BSDFContext&, const Vec3f&, const Vec3f&, int) const override {
+        return Spectrum<N>::Zero();
+    }
     Spectrum<N> weight_grad(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const override {
         if (bs.lobe == kDeltaReflection) return Spectrum<N>::Constant(key == 0 ? 1.f : 0.f);  // d/dR of (17)
         if (key == 0) return Spectrum<N>::Zero();
@@ -55,7 +57,9 @@ public:
         return Spectrum<N>::Constant(ctx.mode == TransportMode::Radiance ? eta_ti * eta_ti : 1.f);
     }
 
-    std::vector<std::string> spectral_keys() const override { return {"specular_reflectance", "specular_transmittance"}; }
+    std::vector<std::string> spectral_keys() const override {
+        return {"specular_reflectance", "specular_transmittance"};
+    }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
         if (key == "specular_reflectance") m_reflectance = v;
         else if (key == "specular_transmittance") m_transmittance = v;

@@ -27,14 +27,14 @@ struct NamedIOR {
     float value;
 };
 constexpr NamedIOR kNamedIORs[] = {
-    {"vacuum", 1.0f},           {"helium", 1.000036f},       {"hydrogen", 1.000132f},
-    {"air", 1.000277f},         {"carbon dioxide", 1.00045f}, {"water", 1.3330f},
-    {"acetone", 1.36f},         {"ethanol", 1.361f},          {"carbon tetrachloride", 1.461f},
-    {"glycerol", 1.4729f},      {"benzene", 1.501f},          {"silicone oil", 1.52045f},
-    {"bromine", 1.661f},        {"water ice", 1.31f},         {"fused quartz", 1.458f},
-    {"pyrex", 1.470f},          {"acrylic glass", 1.49f},     {"polypropylene", 1.49f},
-    {"bk7", 1.5046f},           {"sodium chloride", 1.544f},  {"amber", 1.55f},
-    {"pet", 1.5750f},           {"diamond", 2.419f},
+    {"vacuum", 1.0f},      {"helium", 1.000036f},        {"hydrogen", 1.000132f},
+    {"air", 1.000277f},    {"carbon dioxide", 1.00045f}, {"water", 1.3330f},
+    {"acetone", 1.36f},    {"ethanol", 1.361f},          {"carbon tetrachloride", 1.461f},
+    {"glycerol", 1.4729f}, {"benzene", 1.501f},          {"silicone oil", 1.52045f},
+    {"bromine", 1.661f},   {"water ice", 1.31f},         {"fused quartz", 1.458f},
+    {"pyrex", 1.470f},     {"acrylic glass", 1.49f},     {"polypropylene", 1.49f},
+    {"bk7", 1.5046f},      {"sodium chloride", 1.544f},  {"amber", 1.55f},
+    {"pet", 1.5750f},      {"diamond", 2.419f},
 };
 
 float read_ior(const Props& props, const std::string& key, float def) {
@@ -75,10 +75,9 @@ float read_relative_ior(const Props& props, float default_int, float default_ext
 void read_conductor_ior_rgb(const Props& props, bool& perfect, Eigen::Array3f& eta, Eigen::Array3f& k) {
     std::string material = props.get_string("material", "none");
     if (material != "none")
-        props.fail("material",
-                   "conductor material presets ('" + material +
-                       "') need a spectral IOR database, which latentpt does not ship; give eta and k "
-                       "(rgb) instead, or material \"none\" for a perfect mirror");
+        props.fail("material", "conductor material presets ('" + material +
+                                   "') need a spectral IOR database, which latentpt does not ship; give eta and k "
+                                   "(rgb) instead, or material \"none\" for a perfect mirror");
     perfect = !props.has("eta") && !props.has("k");
     eta = props.get_rgb("eta", Eigen::Array3f::Zero());
     k = props.get_rgb("k", Eigen::Array3f::Ones());

@@ -33,7 +33,7 @@ float MicrofacetDistribution::G1(const Vec3f& v, const Vec3f& m) const {
     if (v.dot(m) * v.z() <= 0.f) return 0.f;
     float xy2 = v.x() * v.x() + v.y() * v.y();
     if (xy2 == 0.f) return 1.f;
-    float at2 = m_alpha * m_alpha * xy2 / (v.z() * v.z());  // (alpha tan theta_v)^2
+    float at2 = m_alpha * m_alpha * xy2 / (v.z() * v.z());                         // (alpha tan theta_v)^2
     if (m_type == MicrofacetType::GGX) return 2.f / (1.f + std::sqrt(1.f + at2));  // docs/bsdfs.md (7)
     // Beckmann Lambda(a), a = 1 / (alpha tan theta); erfc keeps precision for large a.
     double a = 1.0 / std::sqrt(double(at2));

@@ -17,7 +17,8 @@ class PlasticSubstrate {
 public:
     /// Reads diffuse_reflectance (rgb or bitmap; default 0.5) and nonlinear (default false).
     explicit PlasticSubstrate(const Props& props)
-        : m_nonlinear(props.get_bool("nonlinear", false)), m_colour(props, "diffuse_reflectance", Eigen::Array3f::Constant(0.5f)) {}
+        : m_nonlinear(props.get_bool("nonlinear", false)),
+          m_colour(props, "diffuse_reflectance", Eigen::Array3f::Constant(0.5f)) {}
 
     /// The coating's internal diffuse reflectance and its roughness derivative.
     void set_internal_reflectance(float fdr, float dfdr_dalpha = 0.f) {
@@ -36,7 +37,9 @@ public:
     }
 
     /// ρ̃ at this lookup.
-    Spectrum<N> base(const BSDFContext& ctx) const { return m_colour.is_constant() ? m_base : base_of(m_colour.eval(ctx)); }
+    Spectrum<N> base(const BSDFContext& ctx) const {
+        return m_colour.is_constant() ? m_base : base_of(m_colour.eval(ctx));
+    }
     Spectrum<N> albedo(const BSDFContext& ctx) const { return m_colour.eval(ctx); }
     /// ∂ρ̃/∂c for c = keys()[sub]: ∂ρ̃/∂ρ at this lookup's ρ times ∂ρ/∂c.
     Spectrum<N> d_base(const BSDFContext& ctx, int sub) const {

@@ -6,14 +6,22 @@
 
 namespace lpt {
 
-template <int N> std::unique_ptr<BSDF<N>> make_diffuse_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_conductor_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_roughconductor_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_dielectric_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_roughdielectric_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_plastic_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_roughplastic_bsdf(const Props&);
-template <int N> std::unique_ptr<BSDF<N>> make_twosided_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_diffuse_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_conductor_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_roughconductor_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_dielectric_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_roughdielectric_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_plastic_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_roughplastic_bsdf(const Props&);
+template <int N>
+std::unique_ptr<BSDF<N>> make_twosided_bsdf(const Props&);
 
 namespace {
 

@@ -11,7 +11,7 @@
 namespace lpt {
 namespace {
 
-constexpr int K = 32;             // quadrature grid K×K per table entry
+constexpr int K = 32;                // quadrature grid K×K per table entry
 constexpr double kNodeStep = 0.125;  // Δs between nodes in s = ln(α / kMinAlpha)
 
 // Unclamped table values (a lobe's albedo at μ_j) and their ∂/∂α at one α: the raw node data.
@@ -88,17 +88,18 @@ RawTables raw_tables(MicrofacetType type, float eta, float alpha, CoatingLobe lo
     // far too slowly for T on this grid: d ln D/dα grows like tan²θm/α² on tilted microfacets,
     // which reflection sends below the horizon but refraction keeps (32×32: 45 % off T̄'s slope
     // for Beckmann at α = 0.1, 128×128: 3.5 %). At the α floor the difference is one-sided.
-    const double up = std::exp(kSlopeStep), down = std::max(std::exp(-kSlopeStep), MicrofacetDistribution::kMinAlpha / double(alpha));
+    const double up = std::exp(kSlopeStep),
+                 down = std::max(std::exp(-kSlopeStep), MicrofacetDistribution::kMinAlpha / double(alpha));
     MicrofacetDistribution distr_up(type, float(alpha * up)), distr_down(type, float(alpha * down));
     RawTables r;
     for (int j = 0; j < kTransmittanceRes; ++j) {
         float mu = std::max(1e-6f, float(j) / (kTransmittanceRes - 1));
         Vec3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
         r.t[j] = double(float(lobe_albedo(distr, eta, wi, lobe)));
-        if (lobe == CoatingLobe::Reflection)
-            r.dt[j] = dreflectance_dalpha(distr, eta, wi);
+        if (lobe == CoatingLobe::Reflection) r.dt[j] = dreflectance_dalpha(distr, eta, wi);
         else
-            r.dt[j] = (lobe_albedo(distr_up, eta, wi, lobe) - lobe_albedo(distr_down, eta, wi, lobe)) / (double(alpha) * (up - down));
+            r.dt[j] = (lobe_albedo(distr_up, eta, wi, lobe) - lobe_albedo(distr_down, eta, wi, lobe)) /
+                      (double(alpha) * (up - down));
     }
     return r;
 }
@@ -116,7 +117,8 @@ double mean_cosine_weighted(const std::array<float, kTransmittanceRes>& table) {
 }
 
 // Clamps t to [0, 1] (a clamped entry is locally constant in α) and integrates T̄, ∂T̄/∂α.
-TransmittanceTable finish(const std::array<double, kTransmittanceRes>& t, const std::array<double, kTransmittanceRes>& dt) {
+TransmittanceTable finish(const std::array<double, kTransmittanceRes>& t,
+                          const std::array<double, kTransmittanceRes>& dt) {
     TransmittanceTable out;
     for (int j = 0; j < kTransmittanceRes; ++j) {
         float tf = float(t[j]);
@@ -158,7 +160,9 @@ TransmittanceTable rough_lobe_table_direct(MicrofacetType type, float eta, float
 
 TransmittanceTable rough_lobe_table(MicrofacetType type, float eta, float alpha, CoatingLobe lobe) {
     // docs/bsdfs.md (46): cubic Hermite in s over [s_k, s_k+1], x = (s − s_k)/Δs.
-    double s = std::log(std::max(double(alpha), double(MicrofacetDistribution::kMinAlpha)) / MicrofacetDistribution::kMinAlpha) / kNodeStep;
+    double s = std::log(std::max(double(alpha), double(MicrofacetDistribution::kMinAlpha)) /
+                        MicrofacetDistribution::kMinAlpha) /
+               kNodeStep;
     int k = int(std::floor(s));
     double x = s - k, x2 = x * x, x3 = x2 * x;
     const Node& a = node(type, eta, lobe, k);

@@ -126,7 +126,9 @@ public:
         return Spectrum<N>::Constant(reflect_lobe ? w : w * radiance_scale(ctx, bs.eta));
     }
 
-    std::vector<std::string> spectral_keys() const override { return {"specular_reflectance", "specular_transmittance"}; }
+    std::vector<std::string> spectral_keys() const override {
+        return {"specular_reflectance", "specular_transmittance"};
+    }
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
         if (key == "specular_reflectance") m_reflectance = v;
         else if (key == "specular_transmittance") m_transmittance = v;

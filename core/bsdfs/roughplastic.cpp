@@ -131,7 +131,8 @@ public:
         float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
         if (key < m_substrate.key_count())
-            return m_substrate.d_base(ctx, key) * (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
+            return m_substrate.d_base(ctx, key) *
+                   (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
         Vec3f h = (wi + wo).normalized();
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);
         if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
@@ -157,7 +158,8 @@ public:
         float t_i = transmittance(cos_i), t_o = transmittance(cos_o);
         float dt_i = interpolate_mu(m_tables.dt, cos_i), dt_o = interpolate_mu(m_tables.dt, cos_o);
         float k = m_inv_eta2 * kInvPi * cos_o;
-        return m_specular * dspec + m_substrate.d_base_d_alpha(ctx) * (k * t_i * t_o) + m_substrate.base(ctx) * (k * (dt_i * t_o + t_i * dt_o));
+        return m_specular * dspec + m_substrate.d_base_d_alpha(ctx) * (k * t_i * t_o) +
+               m_substrate.base(ctx) * (k * (dt_i * t_o + t_i * dt_o));
     }
 
 private:

@@ -44,10 +44,13 @@ public:
         return m_nested->lambertian() == Lambertian::OneSided ? Lambertian::TwoSided : Lambertian::No;
     }
     Spectrum<N> albedo(const BSDFContext& ctx) const override { return m_nested->albedo(ctx); }
-    Spectrum<N> lambertian_reflectance(const BSDFContext& ctx) const override { return m_nested->lambertian_reflectance(ctx); }
+    Spectrum<N> lambertian_reflectance(const BSDFContext& ctx) const override {
+        return m_nested->lambertian_reflectance(ctx);
+    }
 
     Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
-        return cos_theta(wi) < 0.f ? m_nested->eval_grad(ctx, flip_z(wi), flip_z(wo), key) : m_nested->eval_grad(ctx, wi, wo, key);
+        return cos_theta(wi) < 0.f ? m_nested->eval_grad(ctx, flip_z(wi), flip_z(wo), key)
+                                   : m_nested->eval_grad(ctx, wi, wo, key);
     }
     Spectrum<N> weight_grad(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const override {
         if (cos_theta(wi) >= 0.f) return m_nested->weight_grad(ctx, wi, bs, key);
@@ -65,7 +68,8 @@ public:
         return cos_theta(wi) < 0.f ? m_nested->eval_grad_scalar(ctx, flip_z(wi), flip_z(wo), key)
                                    : m_nested->eval_grad_scalar(ctx, wi, wo, key);
     }
-    Spectrum<N> weight_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs, int key) const override {
+    Spectrum<N> weight_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const BSDFSample<N>& bs,
+                                   int key) const override {
         if (cos_theta(wi) >= 0.f) return m_nested->weight_grad_scalar(ctx, wi, bs, key);
         BSDFSample<N> flipped = bs;
         flipped.wo = flip_z(bs.wo);

@@ -22,7 +22,8 @@ Emitter make_environment_emitter(const Props& props) {
         e.radiance_rgb = props.get_rgb("radiance");
         return e;
     }
-    if (props.type != "envmap") props.fail("type", "unknown environment emitter '" + props.type + "' (known: constant, envmap)");
+    if (props.type != "envmap")
+        props.fail("type", "unknown environment emitter '" + props.type + "' (known: constant, envmap)");
     const std::string file = props.get_string("filename", "");
     if (file.empty()) props.fail("filename", "missing");
     try {

@@ -28,7 +28,8 @@ std::shared_ptr<const EnvMap> EnvMap::load(const std::string& path, const Transf
     return std::make_shared<EnvMap>(t.bitmap(), to_world, scale);
 }
 
-EnvMap::EnvMap(std::shared_ptr<const BitmapData> image, const Transform& to_world, float scale) : m_image(std::move(image)), m_scale(scale) {
+EnvMap::EnvMap(std::shared_ptr<const BitmapData> image, const Transform& to_world, float scale)
+    : m_image(std::move(image)), m_scale(scale) {
     m_to_world = to_world.m.block<3, 3>(0, 0);
     m_to_local = m_to_world.inverse();
     const int w = m_image->width, h = m_image->height;
@@ -52,7 +53,8 @@ EnvMap::EnvMap(std::shared_ptr<const BitmapData> image, const Transform& to_worl
         }
         total += row[j];
     }
-    m_mean = Eigen::Array3f(float(mean_rgb[0] / (4 * kPi)), float(mean_rgb[1] / (4 * kPi)), float(mean_rgb[2] / (4 * kPi)));
+    m_mean =
+        Eigen::Array3f(float(mean_rgb[0] / (4 * kPi)), float(mean_rgb[1] / (4 * kPi)), float(mean_rgb[2] / (4 * kPi)));
     m_mean_luminance = lum(m_mean);
     if (!(total > 0.0)) return;  // black map: pdf 0 everywhere, sample() fails, emission 0
     double acc = 0;

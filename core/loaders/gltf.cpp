@@ -31,14 +31,22 @@ struct AccessorView {
         // Normalized integers map to [0, 1] / [-1, 1] (glTF 2.0 section 3.11).
         auto norm = [&](double v, double max) { return normalized ? std::max(v / max, -1.0) : v; };
         switch (component_type) {
-            case TINYGLTF_COMPONENT_TYPE_BYTE: return norm(load(int8_t()), 127.0);
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return norm(load(uint8_t()), 255.0);
-            case TINYGLTF_COMPONENT_TYPE_SHORT: return norm(load(int16_t()), 32767.0);
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return norm(load(uint16_t()), 65535.0);
-            case TINYGLTF_COMPONENT_TYPE_INT: return load(int32_t());
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return load(uint32_t());
-            case TINYGLTF_COMPONENT_TYPE_FLOAT: return load(float());
-            case TINYGLTF_COMPONENT_TYPE_DOUBLE: return load(double());
+            case TINYGLTF_COMPONENT_TYPE_BYTE:
+                return norm(load(int8_t()), 127.0);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+                return norm(load(uint8_t()), 255.0);
+            case TINYGLTF_COMPONENT_TYPE_SHORT:
+                return norm(load(int16_t()), 32767.0);
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+                return norm(load(uint16_t()), 65535.0);
+            case TINYGLTF_COMPONENT_TYPE_INT:
+                return load(int32_t());
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+                return load(uint32_t());
+            case TINYGLTF_COMPONENT_TYPE_FLOAT:
+                return load(float());
+            case TINYGLTF_COMPONENT_TYPE_DOUBLE:
+                return load(double());
         }
         return 0.0;
     }
@@ -130,8 +138,8 @@ private:
             fail(what + ": bufferView " + std::to_string(a.bufferView) + " runs past the end of its buffer");
         size_t elem = size_t(comp) * size_t(ncomp);
         size_t begin = bv.byteOffset + a.byteOffset;
-        if (a.count > 0 && (begin > view_end || elem > view_end - begin ||
-                            a.count - 1 > (view_end - begin - elem) / size_t(stride)))
+        if (a.count > 0 &&
+            (begin > view_end || elem > view_end - begin || a.count - 1 > (view_end - begin - elem) / size_t(stride)))
             fail(what + ": accessor " + std::to_string(index) + " reads past the end of its bufferView");
         return AccessorView{data.data() + begin, size_t(stride), a.count, a.componentType, ncomp, a.normalized};
     }

@@ -20,7 +20,9 @@ namespace {
 struct Ctx {
     std::string file;
     fs::path dir;
-    [[noreturn]] void fail(const std::string& field, const std::string& msg) const { throw SceneError(file, field, msg); }
+    [[noreturn]] void fail(const std::string& field, const std::string& msg) const {
+        throw SceneError(file, field, msg);
+    }
 
     float number(const json& j, const std::string& field) const {
         if (!j.is_number()) fail(field, "expected a number, got " + std::string(j.type_name()));
@@ -47,7 +49,8 @@ struct Ctx {
     }
 
     Transform transform_op(const json& op, const std::string& field) const {
-        if (!op.is_object() || op.size() != 1) fail(field, "expected one of {\"translate\"|\"scale\"|\"rotate\"|\"lookat\"|\"matrix\": ...}");
+        if (!op.is_object() || op.size() != 1)
+            fail(field, "expected one of {\"translate\"|\"scale\"|\"rotate\"|\"lookat\"|\"matrix\": ...}");
         auto first = op.begin();
         const std::string key = first.key();
         const json& v = first.value();
@@ -55,7 +58,8 @@ struct Ctx {
         if (key == "translate") return Transform::translate(vec3(v, f));
         if (key == "scale") return Transform::scale(vec3(v, f));
         if (key == "rotate") {
-            if (!v.is_object() || !v.contains("axis") || !v.contains("angle")) fail(f, "expected {\"axis\": [x,y,z], \"angle\": degrees}");
+            if (!v.is_object() || !v.contains("axis") || !v.contains("angle"))
+                fail(f, "expected {\"axis\": [x,y,z], \"angle\": degrees}");
             Vec3f axis = vec3(v["axis"], f + ".axis");
             if (axis.norm() == 0.f) fail(f + ".axis", "axis has zero length");
             return Transform::rotate(axis, number(v["angle"], f + ".angle"));
@@ -65,7 +69,8 @@ struct Ctx {
             for (const char* k : {"origin", "target", "up"})
                 if (!v.contains(k)) fail(f + "." + k, "missing");
             try {
-                return Transform::look_at(vec3(v["origin"], f + ".origin"), vec3(v["target"], f + ".target"), vec3(v["up"], f + ".up"));
+                return Transform::look_at(vec3(v["origin"], f + ".origin"), vec3(v["target"], f + ".target"),
+                                          vec3(v["up"], f + ".up"));
             } catch (const std::invalid_argument& e) {
                 fail(f, e.what());
             }
@@ -172,7 +177,8 @@ TriangleMesh inline_mesh(const Ctx& c, const json& s, const std::string& f) {
     const json* xj = c.opt(s, "indices");
     if (!pj || !pj->is_array()) c.fail(f + ".positions", "expected an array of [x,y,z]");
     if (!xj || !xj->is_array()) c.fail(f + ".indices", "expected an array of [i,j,k] (or polygons, fan-triangulated)");
-    for (size_t k = 0; k < pj->size(); ++k) mesh.positions.push_back(c.vec3((*pj)[k], f + ".positions[" + std::to_string(k) + "]"));
+    for (size_t k = 0; k < pj->size(); ++k)
+        mesh.positions.push_back(c.vec3((*pj)[k], f + ".positions[" + std::to_string(k) + "]"));
     for (size_t k = 0; k < xj->size(); ++k) {
         std::string ff = f + ".indices[" + std::to_string(k) + "]";
         const json& poly = (*xj)[k];
@@ -181,7 +187,8 @@ TriangleMesh inline_mesh(const Ctx& c, const json& s, const std::string& f) {
         for (const auto& x : poly) {
             int id = c.integer(x, ff);
             if (id < 0 || id >= int(mesh.positions.size()))
-                c.fail(ff, "vertex index " + std::to_string(id) + " out of range [0, " + std::to_string(mesh.positions.size()) + ")");
+                c.fail(ff, "vertex index " + std::to_string(id) + " out of range [0, " +
+                               std::to_string(mesh.positions.size()) + ")");
             vs.push_back(uint32_t(id));
         }
         for (size_t t = 1; t + 1 < vs.size(); ++t) mesh.indices.insert(mesh.indices.end(), {vs[0], vs[t], vs[t + 1]});
@@ -202,7 +209,8 @@ void read_integrator(const Ctx& c, const json& root, IntegratorSettings& s) {
     if (s.spp < 1) c.fail("integrator.spp", "must be >= 1");
     if (auto* v = c.opt(*ij, "sampler")) {
         std::string m = c.string(*v, "integrator.sampler");
-        if (!parse_sampler(m, s.sampler)) c.fail("integrator.sampler", "expected sobol or independent, got '" + m + "'");
+        if (!parse_sampler(m, s.sampler))
+            c.fail("integrator.sampler", "expected sobol or independent, got '" + m + "'");
     }
     if (auto* v = c.opt(*ij, "light_sampling")) {
         std::string m = c.string(*v, "integrator.light_sampling");
@@ -269,7 +277,8 @@ void read_shapes(const Ctx& c, const json& root, const std::map<std::string, int
         if (!s.contains("type")) c.fail(f + ".type", "missing");
         const std::string type = c.string(s["type"], f + ".type");
         if (!known_shape_type(type))
-            c.fail(f + ".type", "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
+            c.fail(f + ".type",
+                   "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
         const Props props = shape_props(c, s, f, type);
         Shape shape = type == "mesh" ? make_shape_from_mesh(inline_mesh(c, s, f), props, kJsonShapeDefaults)
                                      : make_shape(props, kJsonShapeDefaults);
@@ -287,7 +296,8 @@ void read_shapes(const Ctx& c, const json& root, const std::map<std::string, int
         }
         if (const json* ej = c.opt(s, "emitter")) {
             Props ep = c.props(*ej, f + ".emitter");
-            if (ep.type != "area") c.fail(f + ".emitter.type", "shapes take emitters of type 'area', got '" + ep.type + "'");
+            if (ep.type != "area")
+                c.fail(f + ".emitter.type", "shapes take emitters of type 'area', got '" + ep.type + "'");
             shape.emitter = int(scene.emitters.size());
             scene.emitters.push_back(make_area_emitter(ep, int(scene.shapes.size())));
         }
@@ -305,12 +315,15 @@ void read_environment(const Ctx& c, const json& root, Scene& scene) {
             if (plain.is_object()) plain.erase("to_world");
             Props ep = c.props(plain, f);
             if (ep.type != "constant" && ep.type != "envmap")
-                c.fail(f + ".type", "top-level emitters must be 'constant' or 'envmap' (area lights belong inside a shape), got '" + ep.type + "'");
+                c.fail(f + ".type",
+                       "top-level emitters must be 'constant' or 'envmap' (area lights belong inside a shape), got '" +
+                           ep.type + "'");
             if (scene.environment >= 0) c.fail(f, "only one environment emitter is supported");
             if (ep.type == "envmap") {
                 // {"type": "envmap", "filename": "sky.exr", "scale": 1, "to_world": ...}
                 for (const auto& [k, v] : ejson.items())
-                    if (k != "type" && k != "filename" && k != "scale" && k != "to_world") c.fail(f + "." + k, "unknown envmap key (filename, scale, to_world)");
+                    if (k != "type" && k != "filename" && k != "scale" && k != "to_world")
+                        c.fail(f + "." + k, "unknown envmap key (filename, scale, to_world)");
                 const std::string name = ep.get_string("filename", "");
                 if (name.empty()) c.fail(f + ".filename", "missing");
                 ep.values["filename"] = fs::absolute(c.dir / name).lexically_normal().string();
@@ -335,7 +348,8 @@ void validate_materials(const Scene& scene) {
             std::string users;
             for (const Shape& s : scene.shapes)
                 if (s.material == int(mi)) users += (users.empty() ? "" : ", ") + std::string("'") + s.id + "'";
-            throw explain_texture_error(m, e).with_note(users.empty() ? std::string() : " (material of shape " + users + ")");
+            throw explain_texture_error(m, e).with_note(users.empty() ? std::string()
+                                                                      : " (material of shape " + users + ")");
         }
     }
 }

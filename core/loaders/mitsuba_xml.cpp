@@ -30,7 +30,8 @@ struct IdEntry {
 
 class Loader : private PluginReader {
 public:
-    Loader(const Source& src, Scene& scene) : PluginReader(src), scene(scene), dir(fs::path(src.path()).parent_path()) {}
+    Loader(const Source& src, Scene& scene)
+        : PluginReader(src), scene(scene), dir(fs::path(src.path()).parent_path()) {}
 
     void load(const pugi::xml_node& root) {
         for (pugi::xml_node c : root.children()) {
@@ -44,7 +45,11 @@ public:
             else if (tag == "emitter") read_top_emitter(c);
             else if (tag == "texture") read_top_texture(c);
             else if (tag == "medium") skip_medium(c);
-            else src.fail(c, "", "<" + tag + "> is not supported at the top level of <scene> (known: default, integrator, sensor, bsdf, texture, shape, emitter)");
+            else
+                src.fail(c, "",
+                         "<" + tag +
+                             "> is not supported at the top level of <scene> (known: default, integrator, sensor, "
+                             "bsdf, texture, shape, emitter)");
         }
         if (!have_sensor) src.fail(root, "sensor", "scene has no <sensor>");
         if (scene.shapes.empty()) src.fail(root, "shape", "scene has no <shape>");
@@ -62,13 +67,17 @@ private:
     void register_id(const std::string& id, const std::string& tag, int line, std::shared_ptr<Props> props = nullptr) {
         if (id.empty()) return;
         auto [it, fresh] = ids.emplace(id, IdEntry{tag, line, std::move(props), -1});
-        if (!fresh) src.fail_at(line, "", "duplicate id '" + id + "' (first used by the <" + it->second.tag + "> at line " + std::to_string(it->second.line) + ")");
+        if (!fresh)
+            src.fail_at(line, "",
+                        "duplicate id '" + id + "' (first used by the <" + it->second.tag + "> at line " +
+                            std::to_string(it->second.line) + ")");
     }
     IdEntry& resolve_ref(const pugi::xml_node& ref) {
         check_attributes(src, ref, {"id", "name"});
         std::string id = required_attribute(src, ref, "id");
         auto it = ids.find(id);
-        if (it == ids.end()) src.fail(ref, "", "reference to undefined id '" + id + "' (ids must be defined before they are used)");
+        if (it == ids.end())
+            src.fail(ref, "", "reference to undefined id '" + id + "' (ids must be defined before they are used)");
         return it->second;
     }
 
@@ -82,14 +91,17 @@ private:
     /// reported at this element's line; the BSDF later gets it from the cache.
     std::shared_ptr<Props> read_texture(const pugi::xml_node& n, const std::string& what) {
         Plugin p = read_plugin(n, what);
-        if (p.type != "bitmap") src.fail_at(p.line, p.where + ".type", "unknown texture plugin '" + p.type + "' (known: bitmap)");
+        if (p.type != "bitmap")
+            src.fail_at(p.line, p.where + ".type", "unknown texture plugin '" + p.type + "' (known: bitmap)");
         if (p.find("to_uv")) fail_value(p, "to_uv", "to_uv is not supported yet (uvs are used as they are)");
         allow_only(p, {"filename", "raw", "filter_type", "wrap_mode"});
         for (const pugi::xml_node& c : p.children) unexpected_child(p, c);
         if (!p.find("filename")) src.fail_at(p.line, p.where + ".filename", "a bitmap texture needs a filename");
         std::string filter = get_string(p, "filter_type", "bilinear"), wrap = get_string(p, "wrap_mode", "repeat");
-        if (filter != "bilinear" && filter != "nearest") fail_value(p, "filter_type", "expected bilinear or nearest, got '" + filter + "'");
-        if (wrap != "repeat" && wrap != "mirror" && wrap != "clamp") fail_value(p, "wrap_mode", "expected repeat, mirror or clamp, got '" + wrap + "'");
+        if (filter != "bilinear" && filter != "nearest")
+            fail_value(p, "filter_type", "expected bilinear or nearest, got '" + filter + "'");
+        if (wrap != "repeat" && wrap != "mirror" && wrap != "clamp")
+            fail_value(p, "wrap_mode", "expected repeat, mirror or clamp, got '" + wrap + "'");
         const bool raw = get_bool(p, "raw", false);
         std::string file = fs::absolute(dir / get_string(p, "filename", "")).lexically_normal().string();
         try {
@@ -106,14 +118,17 @@ private:
     void read_top_texture(const pugi::xml_node& n) {
         auto props = read_texture(n, "texture");
         std::string id = n.attribute("id").value();
-        if (id.empty()) src.fail(n, "texture", "a top-level <texture> needs an id (use it with <ref name=\"...\" id=\"...\"/> in a BSDF)");
+        if (id.empty())
+            src.fail(n, "texture",
+                     "a top-level <texture> needs an id (use it with <ref name=\"...\" id=\"...\"/> in a BSDF)");
         register_id(id, "texture", src.line(n), props);
     }
     /// Puts a texture under `name` in a BSDF's props; a name given twice is an error, as for
     /// properties.
     void add_texture(const Plugin& p, Props& props, const pugi::xml_node& c, std::shared_ptr<Props> tex) {
         std::string name = c.attribute("name").value();
-        if (name.empty()) src.fail(c, p.where, "<" + std::string(c.name()) + "> for a texture parameter needs name=\"<parameter>\"");
+        if (name.empty())
+            src.fail(c, p.where, "<" + std::string(c.name()) + "> for a texture parameter needs name=\"<parameter>\"");
         if (props.has(name)) src.fail(c, p.where + "." + name, "property '" + name + "' is given twice");
         props.values[name] = std::move(tex);
     }
@@ -143,7 +158,10 @@ private:
                     add_texture(p, *props, c, e.props);
                     continue;
                 }
-                if (e.tag != "bsdf") src.fail(c, p.where, "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag + ">, expected a <bsdf> or <texture>");
+                if (e.tag != "bsdf")
+                    src.fail(c, p.where,
+                             "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag +
+                                 ">, expected a <bsdf> or <texture>");
                 child = e.props;
             } else if (tag == "texture") {
                 add_texture(p, *props, c, read_texture(c, p.where + "." + c.attribute("name").value()));
@@ -158,8 +176,10 @@ private:
             // "expected an rgb triple".
             rethrow_at(src, explain_texture_error(*props, e), p.line);
         }
-        if (nested > 0 && p.type != "twosided") src.fail(n, p.where, "bsdf '" + p.type + "' does not take a nested BSDF");
-        if (nested > 1) src.fail(n, p.where, "twosided with a separate back-side BSDF is not supported (give one nested BSDF)");
+        if (nested > 0 && p.type != "twosided")
+            src.fail(n, p.where, "bsdf '" + p.type + "' does not take a nested BSDF");
+        if (nested > 1)
+            src.fail(n, p.where, "twosided with a separate back-side BSDF is not supported (give one nested BSDF)");
         register_id(p.id, "bsdf", p.line, props);
         return props;
     }
@@ -193,7 +213,9 @@ private:
         // focus_distance only matters to thinlens; a pinhole ignores it as Mitsuba's perspective does.
         allow_only(p, {"fov", "fov_axis", "near_clip", "far_clip", "to_world", "focus_distance"});
         Camera& cam = scene.camera;
-        if (!p.find("fov")) src.fail_at(p.line, p.where + ".fov", "perspective sensor needs 'fov' in degrees (focal_length is not supported)");
+        if (!p.find("fov"))
+            src.fail_at(p.line, p.where + ".fov",
+                        "perspective sensor needs 'fov' in degrees (focal_length is not supported)");
         cam.fov = get_float(p, "fov", 45.f);
         if (!(cam.fov > 0.f && cam.fov < 180.f)) fail_value(p, "fov", "must be in (0, 180) degrees");
         std::string axis = get_string(p, "fov_axis", "x");
@@ -201,7 +223,8 @@ private:
         else if (axis == "y") cam.fov_axis = FovAxis::Y;
         else if (axis == "smaller") cam.fov_axis = FovAxis::Smaller;
         else if (axis == "larger") cam.fov_axis = FovAxis::Larger;
-        else if (axis == "diagonal") fail_value(p, "fov_axis", "fov_axis 'diagonal' is not supported (use x, y, smaller or larger)");
+        else if (axis == "diagonal")
+            fail_value(p, "fov_axis", "fov_axis 'diagonal' is not supported (use x, y, smaller or larger)");
         else fail_value(p, "fov_axis", "expected x, y, smaller, larger or diagonal, got '" + axis + "'");
         cam.near_clip = get_float(p, "near_clip", 1e-2f);
         cam.far_clip = get_float(p, "far_clip", 1e4f);
@@ -211,7 +234,8 @@ private:
         // Like Mitsuba, refuse scale: it would silently change the field of view.
         cam.world_from_camera = get_transform(p, "to_world");
         Eigen::Matrix3f r = cam.world_from_camera.m.topLeftCorner<3, 3>();
-        if (!(r.transpose() * r).isIdentity(1e-3f)) fail_value(p, "to_world", "camera to_world must not scale or shear (Mitsuba rejects it too)");
+        if (!(r.transpose() * r).isIdentity(1e-3f))
+            fail_value(p, "to_world", "camera to_world must not scale or shear (Mitsuba rejects it too)");
 
         bool have_film = false;
         for (const pugi::xml_node& c : p.children) {
@@ -226,7 +250,10 @@ private:
             else unexpected_child(p, c);
         }
         // Mitsuba's default film filters with a gaussian, which we cannot reproduce.
-        if (!have_film) src.fail_at(p.line, "film", "sensor has no <film>: Mitsuba's default uses a gaussian rfilter, which is unsupported; add <film type=\"hdrfilm\"> with <rfilter type=\"box\"/> or \"tent\"");
+        if (!have_film)
+            src.fail_at(p.line, "film",
+                        "sensor has no <film>: Mitsuba's default uses a gaussian rfilter, which is unsupported; add "
+                        "<film type=\"hdrfilm\"> with <rfilter type=\"box\"/> or \"tent\"");
     }
 
     void read_film(const pugi::xml_node& n) {
@@ -248,14 +275,17 @@ private:
             PixelFilter& pf = scene.camera.filter;
             if (f.type == "box") pf = {PixelFilter::Type::Box, 0.5f};
             else if (f.type == "tent") pf = {PixelFilter::Type::Tent, 1.f};
-            else if (f.type == "gaussian") src.fail_at(f.line, "rfilter.type", "rfilter 'gaussian' is unsupported, use box or tent");
+            else if (f.type == "gaussian")
+                src.fail_at(f.line, "rfilter.type", "rfilter 'gaussian' is unsupported, use box or tent");
             else unknown_plugin(f, "box, tent");
             allow_only(f, {"radius"});
             for (const pugi::xml_node& cc : f.children) unexpected_child(f, cc);
             pf.radius = get_float(f, "radius", pf.radius);
             if (!(pf.radius > 0.f)) fail_value(f, "radius", "must be > 0");
         }
-        if (!have_filter) src.fail_at(p.line, "rfilter", "film has no <rfilter>: Mitsuba's default is gaussian, which is unsupported, use box or tent");
+        if (!have_filter)
+            src.fail_at(p.line, "rfilter",
+                        "film has no <rfilter>: Mitsuba's default is gaussian, which is unsupported, use box or tent");
     }
 
     void read_sampler(const pugi::xml_node& n) {
@@ -276,7 +306,8 @@ private:
 
     void read_top_emitter(const pugi::xml_node& n) {
         Plugin p = read_plugin(n, "emitter");
-        if (p.type == "area") src.fail_at(p.line, p.where + ".type", "an 'area' emitter must be nested inside a <shape>");
+        if (p.type == "area")
+            src.fail_at(p.line, p.where + ".type", "an 'area' emitter must be nested inside a <shape>");
         if (p.type != "constant" && p.type != "envmap") unknown_plugin(p, "area (inside a shape), constant, envmap");
         if (scene.environment >= 0) src.fail_at(p.line, p.where, "only one environment emitter is supported");
         Emitter e = p.type == "envmap" ? read_envmap(p) : read_emitter_props(p, EmitterKind::Constant, -1);
@@ -298,7 +329,8 @@ private:
         try {
             return make_environment_emitter(props);
         } catch (const SceneError& err) {
-            fail_value(p, "filename", err.message() + " (the environment map; see the scene's SOURCE/README for where to get it)");
+            fail_value(p, "filename",
+                       err.message() + " (the environment map; see the scene's SOURCE/README for where to get it)");
         }
     }
 
@@ -309,7 +341,8 @@ private:
             unexpected_child(p, c);
         }
         try {
-            return kind == EmitterKind::Area ? make_area_emitter(to_props(p), shape) : make_environment_emitter(to_props(p));
+            return kind == EmitterKind::Area ? make_area_emitter(to_props(p), shape)
+                                             : make_environment_emitter(to_props(p));
         } catch (const SceneError& err) {
             rethrow_at(src, err, p.line);
         }
@@ -361,7 +394,10 @@ private:
                 } else {
                     IdEntry& e = resolve_ref(c);
                     if (e.tag == "medium") continue;  // interior/exterior media are ignored
-                    if (e.tag != "bsdf") src.fail(c, p.where, "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag + ">; a shape takes a <bsdf>");
+                    if (e.tag != "bsdf")
+                        src.fail(c, p.where,
+                                 "ref '" + std::string(c.attribute("id").value()) + "' names a <" + e.tag +
+                                     ">; a shape takes a <bsdf>");
                     if (e.material < 0) e.material = add_material(*e.props);
                     material = e.material;
                 }
@@ -369,7 +405,8 @@ private:
                 shape.material = material;
             } else if (tag == "emitter") {
                 Plugin ep = read_plugin(c, p.where + ".emitter");
-                if (ep.type != "area") src.fail_at(ep.line, ep.where + ".type", "a shape's emitter must be 'area', got '" + ep.type + "'");
+                if (ep.type != "area")
+                    src.fail_at(ep.line, ep.where + ".type", "a shape's emitter must be 'area', got '" + ep.type + "'");
                 if (shape.emitter >= 0) src.fail(c, p.where, "shape has more than one emitter");
                 Emitter e = read_emitter_props(ep, EmitterKind::Area, index);
                 register_id(ep.id, ep.tag, ep.line);
@@ -425,9 +462,12 @@ Scene load_scene_mitsuba_xml(const std::string& path, const std::map<std::string
 
     pugi::xml_document doc;
     pugi::xml_parse_result parsed = doc.load_buffer(src.text().data(), src.text().size());
-    if (!parsed) throw SceneError(path, "", std::string("malformed XML: ") + parsed.description(), src.line_of_offset(parsed.offset));
+    if (!parsed)
+        throw SceneError(path, "", std::string("malformed XML: ") + parsed.description(),
+                         src.line_of_offset(parsed.offset));
     pugi::xml_node root = doc.document_element();
-    if (std::string(root.name()) != "scene") src.fail(root, "", "the root element must be <scene>, got <" + std::string(root.name()) + ">");
+    if (std::string(root.name()) != "scene")
+        src.fail(root, "", "the root element must be <scene>, got <" + std::string(root.name()) + ">");
 
     substitute_parameters(src, root, defines);
     check_attributes(src, root, {"version"});
@@ -438,7 +478,11 @@ Scene load_scene_mitsuba_xml(const std::string& path, const std::map<std::string
     } catch (const std::exception&) {
         src.fail(root, "version", "cannot read scene version '" + version + "'");
     }
-    if (major < 2) src.fail(root, "version", "scene version " + version + " is a Mitsuba 0.x file (camelCase names such as toWorld, sampleCount); only versions 2.x and 3.x are supported");
+    if (major < 2)
+        src.fail(root, "version",
+                 "scene version " + version +
+                     " is a Mitsuba 0.x file (camelCase names such as toWorld, sampleCount); only versions 2.x and 3.x "
+                     "are supported");
     if (major > 3) src.fail(root, "version", "scene version " + version + " is not supported (2.x or 3.x)");
 
     Scene scene;

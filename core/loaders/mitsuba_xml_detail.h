@@ -47,7 +47,7 @@ enum class ValueKind { Float, Integer, Boolean, String, Rgb, Point, Vector, Tran
 /// One property element (<float name="fov" value="40"/>, <rgb>, <transform>, ...).
 struct Value {
     ValueKind kind = ValueKind::Float;
-    PropValue value;   ///< Integer is stored as float here; the exact value is in `integer`
+    PropValue value;  ///< Integer is stored as float here; the exact value is in `integer`
     long long integer = 0;
     int line = -1;
 };
@@ -56,7 +56,8 @@ bool is_property_tag(const std::string& tag);
 /// Parses a property element; returns its name (the `name` attribute).
 std::string parse_property(const Source& src, const pugi::xml_node& n, Value& out);
 /// Numbers separated by commas and/or whitespace; `what` names the value in errors.
-std::vector<float> parse_floats(const Source& src, const pugi::xml_node& n, const std::string& what, const std::string& text);
+std::vector<float> parse_floats(const Source& src, const pugi::xml_node& n, const std::string& what,
+                                const std::string& text);
 /// A <transform> element: its operations composed in Mitsuba order (each later one left-multiplies).
 Transform parse_transform(const Source& src, const pugi::xml_node& n);
 const char* kind_name(ValueKind k);

@@ -55,19 +55,22 @@ protected:
             Value v;
             std::string name = parse_property(src, c, v);
             if (const Value* old = p.find(name))
-                src.fail(c, p.where + "." + name, "property '" + name + "' is given twice (first at line " + std::to_string(old->line) + ")");
+                src.fail(c, p.where + "." + name,
+                         "property '" + name + "' is given twice (first at line " + std::to_string(old->line) + ")");
             p.values[name] = v;
         }
         return p;
     }
 
     // Typed property access; a property of the wrong kind is an error at its line.
-    const Value* typed(const Plugin& p, const std::string& name, std::initializer_list<ValueKind> kinds, const char* expected) const {
+    const Value* typed(const Plugin& p, const std::string& name, std::initializer_list<ValueKind> kinds,
+                       const char* expected) const {
         const Value* v = p.find(name);
         if (!v) return nullptr;
         for (ValueKind k : kinds)
             if (v->kind == k) return v;
-        src.fail_at(v->line, p.where + "." + name, std::string("expected <") + expected + ">, got <" + kind_name(v->kind) + ">");
+        src.fail_at(v->line, p.where + "." + name,
+                    std::string("expected <") + expected + ">, got <" + kind_name(v->kind) + ">");
     }
     float get_float(const Plugin& p, const std::string& name, float def) const {
         const Value* v = typed(p, name, {ValueKind::Float, ValueKind::Integer}, "float");
@@ -106,21 +109,24 @@ protected:
             if (ok) continue;
             std::string known;
             for (const char* n : names) known += (known.empty() ? "" : ", ") + std::string(n);
-            src.fail_at(v.line, p.where + "." + k, "<" + p.tag + " type=\"" + p.type + "\"> does not support property '" + k + "'" +
-                                                       (known.empty() ? "" : " (supported: " + known + ")"));
+            src.fail_at(v.line, p.where + "." + k,
+                        "<" + p.tag + " type=\"" + p.type + "\"> does not support property '" + k + "'" +
+                            (known.empty() ? "" : " (supported: " + known + ")"));
         }
     }
     [[noreturn]] void unknown_plugin(const Plugin& p, const std::string& known) const {
         src.fail_at(p.line, p.where + ".type", "unknown " + p.tag + " plugin '" + p.type + "' (known: " + known + ")");
     }
     [[noreturn]] void unexpected_child(const Plugin& p, const pugi::xml_node& c) const {
-        src.fail(c, p.where, "unexpected <" + std::string(c.name()) + "> inside <" + p.tag + " type=\"" + p.type + "\">");
+        src.fail(c, p.where,
+                 "unexpected <" + std::string(c.name()) + "> inside <" + p.tag + " type=\"" + p.type + "\">");
     }
     /// A <texture> where only BSDFs take one (shapes, emitters).
     [[noreturn]] void fail_texture(const Plugin& p, const pugi::xml_node& n) const {
         std::string name = n.attribute("name").value();
-        src.fail(n, p.where + "." + name, "textured '" + name + "' on <" + p.tag + " type=\"" + p.type +
-                                              "\"> is not supported yet (bitmap textures work as BSDF parameters)");
+        src.fail(n, p.where + "." + name,
+                 "textured '" + name + "' on <" + p.tag + " type=\"" + p.type +
+                     "\"> is not supported yet (bitmap textures work as BSDF parameters)");
     }
     /// The line of the property an error names (`<where>.<name>`), else the plugin's.
     int line_of(const Plugin& p, const std::string& field) const {

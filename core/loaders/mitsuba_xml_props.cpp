@@ -28,7 +28,9 @@ void check_attributes(const Source& src, const pugi::xml_node& n, std::initializ
         if (!ok) {
             std::string known;
             for (const char* name : allowed) known += (known.empty() ? "" : ", ") + std::string(name);
-            src.fail(n, "", "<" + std::string(n.name()) + ">: unexpected attribute '" + a.name() + "' (allowed: " + known + ")");
+            src.fail(
+                n, "",
+                "<" + std::string(n.name()) + ">: unexpected attribute '" + a.name() + "' (allowed: " + known + ")");
         }
     }
 }
@@ -59,8 +61,9 @@ std::string substitute(const Source& src, const pugi::xml_node& n, const pugi::x
         std::string name = in.substr(i + 1, j - i - 1);
         auto it = params.find(name);
         if (it == params.end())
-            src.fail(n, a.name(), "undefined parameter '$" + name + "' in <" + n.name() + ">: declare <default name=\"" + name +
-                                      "\" value=\"...\"/> or pass it as a define");
+            src.fail(n, a.name(),
+                     "undefined parameter '$" + name + "' in <" + n.name() + ">: declare <default name=\"" + name +
+                         "\" value=\"...\"/> or pass it as a define");
         out += it->second;
         i = j - 1;
     }
@@ -98,7 +101,10 @@ Vec3f named_vector(const Source& src, const pugi::xml_node& n, const char* vec_a
             src.fail(n, vec_attr, "give either '" + std::string(vec_attr) + "' or x/y/z, not both");
         std::vector<float> v = parse_floats(src, n, vec_attr, a.value());
         if (allow_broadcast && v.size() == 1) return Vec3f::Constant(v[0]);
-        if (v.size() != 3) src.fail(n, vec_attr, std::string("expected ") + (allow_broadcast ? "1 or " : "") + "3 numbers, got '" + a.value() + "'");
+        if (v.size() != 3)
+            src.fail(
+                n, vec_attr,
+                std::string("expected ") + (allow_broadcast ? "1 or " : "") + "3 numbers, got '" + a.value() + "'");
         return Vec3f(v[0], v[1], v[2]);
     }
     Vec3f out = Vec3f::Constant(def);
@@ -168,12 +174,14 @@ void substitute_parameters(const Source& src, pugi::xml_node scene, std::map<std
         params.emplace(name, value);  // a define, or an earlier <default> of the same name, wins
     }
     for (pugi::xml_attribute a : scene.attributes())
-        if (std::string(a.value()).find('$') != std::string::npos) a.set_value(substitute(src, scene, a, params).c_str());
+        if (std::string(a.value()).find('$') != std::string::npos)
+            a.set_value(substitute(src, scene, a, params).c_str());
     for (pugi::xml_node c : scene.children())
         if (c.type() == pugi::node_element && std::string(c.name()) != "default") substitute_tree(src, c, params);
 }
 
-std::vector<float> parse_floats(const Source& src, const pugi::xml_node& n, const std::string& what, const std::string& text) {
+std::vector<float> parse_floats(const Source& src, const pugi::xml_node& n, const std::string& what,
+                                const std::string& text) {
     std::vector<float> out;
     size_t i = 0;
     auto sep = [](char c) { return c == ',' || std::isspace(static_cast<unsigned char>(c)); };
@@ -199,20 +207,29 @@ Transform parse_transform(const Source& src, const pugi::xml_node& n) {
 }
 
 bool is_property_tag(const std::string& tag) {
-    static const char* kTags[] = {"float", "integer", "boolean", "string", "rgb", "spectrum", "point", "vector", "transform"};
+    static const char* kTags[] = {"float",    "integer", "boolean", "string",   "rgb",
+                                  "spectrum", "point",   "vector",  "transform"};
     return std::find_if(std::begin(kTags), std::end(kTags), [&](const char* t) { return tag == t; }) != std::end(kTags);
 }
 
 const char* kind_name(ValueKind k) {
     switch (k) {
-    case ValueKind::Float: return "float";
-    case ValueKind::Integer: return "integer";
-    case ValueKind::Boolean: return "boolean";
-    case ValueKind::String: return "string";
-    case ValueKind::Rgb: return "rgb";
-    case ValueKind::Point: return "point";
-    case ValueKind::Vector: return "vector";
-    case ValueKind::Transform: return "transform";
+        case ValueKind::Float:
+            return "float";
+        case ValueKind::Integer:
+            return "integer";
+        case ValueKind::Boolean:
+            return "boolean";
+        case ValueKind::String:
+            return "string";
+        case ValueKind::Rgb:
+            return "rgb";
+        case ValueKind::Point:
+            return "point";
+        case ValueKind::Vector:
+            return "vector";
+        case ValueKind::Transform:
+            return "transform";
     }
     return "?";
 }
@@ -265,11 +282,15 @@ std::string parse_property(const Source& src, const pugi::xml_node& n, Value& ou
         // upsampling that RGB rendering does not have.
         out.kind = ValueKind::Rgb;
         if (tag == "spectrum" && value.find(':') != std::string::npos)
-            src.fail(n, name, "<spectrum> with wavelength:value pairs is not supported; use <rgb> or one uniform value");
+            src.fail(n, name,
+                     "<spectrum> with wavelength:value pairs is not supported; use <rgb> or one uniform value");
         std::vector<float> v = parse_floats(src, n, name, value);
         if (v.size() == 1) out.value = Eigen::Array3f::Constant(v[0]);
         else if (v.size() == 3 && tag == "rgb") out.value = Eigen::Array3f(v[0], v[1], v[2]);
-        else src.fail(n, name, "<" + tag + "> expects " + (tag == "rgb" ? "\"r, g, b\" or " : "") + "one value, got '" + value + "'");
+        else
+            src.fail(
+                n, name,
+                "<" + tag + "> expects " + (tag == "rgb" ? "\"r, g, b\" or " : "") + "one value, got '" + value + "'");
     } else {
         src.fail(n, name, "<" + tag + "> is not a property element");
     }

@@ -21,11 +21,11 @@ enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64
 
 bool parse_type(const std::string& s, PlyType& t) {
     static const std::pair<const char*, PlyType> names[] = {
-        {"char", PlyType::Int8},     {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
-        {"uint8", PlyType::UInt8},   {"short", PlyType::Int16},     {"int16", PlyType::Int16},
-        {"ushort", PlyType::UInt16}, {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
-        {"int32", PlyType::Int32},   {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
-        {"float", PlyType::Float32}, {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+        {"char", PlyType::Int8},      {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
+        {"uint8", PlyType::UInt8},    {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+        {"ushort", PlyType::UInt16},  {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
+        {"int32", PlyType::Int32},    {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
+        {"float", PlyType::Float32},  {"float32", PlyType::Float32}, {"double", PlyType::Float64},
         {"float64", PlyType::Float64}};
     for (const auto& [name, type] : names)
         if (s == name) return t = type, true;
@@ -34,10 +34,18 @@ bool parse_type(const std::string& s, PlyType& t) {
 
 size_t type_size(PlyType t) {
     switch (t) {
-        case PlyType::Int8: case PlyType::UInt8: return 1;
-        case PlyType::Int16: case PlyType::UInt16: return 2;
-        case PlyType::Int32: case PlyType::UInt32: case PlyType::Float32: return 4;
-        case PlyType::Float64: return 8;
+        case PlyType::Int8:
+        case PlyType::UInt8:
+            return 1;
+        case PlyType::Int16:
+        case PlyType::UInt16:
+            return 2;
+        case PlyType::Int32:
+        case PlyType::UInt32:
+        case PlyType::Float32:
+            return 4;
+        case PlyType::Float64:
+            return 8;
     }
     return 0;
 }
@@ -82,14 +90,40 @@ public:
         }();
         if ((m_format == PlyFormat::BinaryLE) != host_le) std::reverse(b, b + n);
         switch (t) {
-            case PlyType::Int8: return double(int8_t(b[0]));
-            case PlyType::UInt8: return double(b[0]);
-            case PlyType::Int16: { int16_t v; std::memcpy(&v, b, 2); return v; }
-            case PlyType::UInt16: { uint16_t v; std::memcpy(&v, b, 2); return v; }
-            case PlyType::Int32: { int32_t v; std::memcpy(&v, b, 4); return v; }
-            case PlyType::UInt32: { uint32_t v; std::memcpy(&v, b, 4); return v; }
-            case PlyType::Float32: { float v; std::memcpy(&v, b, 4); return v; }
-            case PlyType::Float64: { double v; std::memcpy(&v, b, 8); return v; }
+            case PlyType::Int8:
+                return double(int8_t(b[0]));
+            case PlyType::UInt8:
+                return double(b[0]);
+            case PlyType::Int16: {
+                int16_t v;
+                std::memcpy(&v, b, 2);
+                return v;
+            }
+            case PlyType::UInt16: {
+                uint16_t v;
+                std::memcpy(&v, b, 2);
+                return v;
+            }
+            case PlyType::Int32: {
+                int32_t v;
+                std::memcpy(&v, b, 4);
+                return v;
+            }
+            case PlyType::UInt32: {
+                uint32_t v;
+                std::memcpy(&v, b, 4);
+                return v;
+            }
+            case PlyType::Float32: {
+                float v;
+                std::memcpy(&v, b, 4);
+                return v;
+            }
+            case PlyType::Float64: {
+                double v;
+                std::memcpy(&v, b, 8);
+                return v;
+            }
         }
         return 0.0;
     }
@@ -97,8 +131,9 @@ public:
 
     /// Ascii errors carry the line; binary ones the record, which is all a hex dump needs.
     [[noreturn]] void fail(const std::string& what, size_t record) const {
-        throw SceneError(m_path, "", what + " in element '" + m_element->name + "' (record " + std::to_string(record) +
-                                         " of " + std::to_string(m_element->count) + ")",
+        throw SceneError(m_path, "",
+                         what + " in element '" + m_element->name + "' (record " + std::to_string(record) + " of " +
+                             std::to_string(m_element->count) + ")",
                          m_format == PlyFormat::Ascii ? m_line : -1);
     }
 
@@ -114,8 +149,7 @@ private:
         std::string tok = m_data.substr(start, m_pos - start);
         char* end = nullptr;
         double v = std::strtod(tok.c_str(), &end);
-        if (*end != '\0' || (is_integer(t) && v != std::floor(v)))
-            fail("bad value '" + tok + "'", record);
+        if (*end != '\0' || (is_integer(t) && v != std::floor(v))) fail("bad value '" + tok + "'", record);
         return v;
     }
 
@@ -207,7 +241,6 @@ int find_prop(const PlyElement& e, const char* name) {
     return -1;
 }
 
-
 /// The vertex element: positions, and normals and uvs where all their properties are present.
 void read_vertices(const std::string& path, const PlyElement& e, PlyBody& body, size_t reserve, TriangleMesh& mesh) {
     int ix = find_prop(e, "x"), iy = find_prop(e, "y"), iz = find_prop(e, "z");
@@ -215,11 +248,13 @@ void read_vertices(const std::string& path, const PlyElement& e, PlyBody& body, 
     int in[3] = {find_prop(e, "nx"), find_prop(e, "ny"), find_prop(e, "nz")};
     bool has_n = in[0] >= 0 && in[1] >= 0 && in[2] >= 0;
     int iu = -1, iv = -1;
-    const std::pair<const char*, const char*> uv_names[] = {{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
+    const std::pair<const char*, const char*> uv_names[] = {
+        {"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}};
     for (auto [u, v] : uv_names)
         if (iu < 0 && find_prop(e, u) >= 0 && find_prop(e, v) >= 0) iu = find_prop(e, u), iv = find_prop(e, v);
     for (int i : {ix, iy, iz, in[0], in[1], in[2], iu, iv})
-        if (i >= 0 && e.props[size_t(i)].is_list) throw SceneError(path, "", "vertex property '" + e.props[size_t(i)].name + "' is a list");
+        if (i >= 0 && e.props[size_t(i)].is_list)
+            throw SceneError(path, "", "vertex property '" + e.props[size_t(i)].name + "' is a list");
     std::vector<double> values(e.props.size());
     mesh.positions.reserve(reserve);
     for (size_t r = 0; r < e.count; ++r) {
@@ -265,10 +300,13 @@ void read_faces(const std::string& path, const PlyElement& e, PlyBody& body, siz
             for (double j = 0; j < n; ++j) {
                 double idx = body.read(p.type, r);
                 if (idx < 0 || idx > 4294967295.0)
-                    body.fail("vertex index " + std::to_string(static_cast<long long>(idx)) + " outside the 32-bit unsigned range", r);
+                    body.fail("vertex index " + std::to_string(static_cast<long long>(idx)) +
+                                  " outside the 32-bit unsigned range",
+                              r);
                 poly.push_back(uint32_t(idx));
             }
-            for (size_t j = 1; j + 1 < poly.size(); ++j) mesh.indices.insert(mesh.indices.end(), {poly[0], poly[j], poly[j + 1]});
+            for (size_t j = 1; j + 1 < poly.size(); ++j)
+                mesh.indices.insert(mesh.indices.end(), {poly[0], poly[j], poly[j + 1]});
         }
     }
 }

@@ -16,7 +16,9 @@ constexpr int kRes = 16;
 
 Scene cornell() {
     return load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
-                      {{"camera.width", std::to_string(kRes)}, {"camera.height", std::to_string(kRes)}, {"integrator.max_depth", "4"}});
+                      {{"camera.width", std::to_string(kRes)},
+                       {"camera.height", std::to_string(kRes)},
+                       {"integrator.max_depth", "4"}});
 }
 
 RenderOptions target_options(const Scene& s, int spp, uint64_t seed) {
@@ -56,7 +58,8 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
         Scene scene = cornell();
         LatentModel m(scene, Parameterisation::Code, 2);
         m.terms().ambient = m.terms().occlusion = extra_terms;
-        double initial = huber_loss(render_toned(m, target_options(scene, 4, 5), ToneCurve::Clip).data(), target.data(), target.size(), 1.f, nullptr);
+        double initial = huber_loss(render_toned(m, target_options(scene, 4, 5), ToneCurve::Clip).data(), target.data(),
+                                    target.size(), 1.f, nullptr);
         FitOptions fo = fit_options(400);
         fo.reuse_paths = reuse_paths;
         FitState st = fit_latent(m, target, kRes, kRes, fo);
@@ -65,8 +68,9 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
             auto img = render_toned(m, target_options(scene, 4, 2000 + s), ToneCurve::Clip);
             final_loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
         }
-        std::cout << (extra_terms ? "Ie+Ia+Ic" : "Ie only") << " (reuse " << reuse_paths << "): initial " << initial << ", final " << final_loss << ", noise floor " << floor
-                  << ", skipped steps " << st.skipped_steps << "\n";
+        std::cout << (extra_terms ? "Ie+Ia+Ic" : "Ie only") << " (reuse " << reuse_paths << "): initial " << initial
+                  << ", final " << final_loss << ", noise floor " << floor << ", skipped steps " << st.skipped_steps
+                  << "\n";
         EXPECT_EQ(st.skipped_steps, 0);
         return std::pair{initial, final_loss};
     };
@@ -108,7 +112,8 @@ void expect_resume_bit_identical(int reuse_paths, int expected_next) {
     FitOptions killed = o;
     killed.checkpoint_every = 10;
     killed.checkpoint_dir = ckpt;
-    fit_latent(part, target, kRes, kRes, killed, {}, [](const FitRecord& r, const FitState&) { return r.iteration < 16; });
+    fit_latent(part, target, kRes, kRes, killed, {},
+               [](const FitRecord& r, const FitState&) { return r.iteration < 16; });
     Scene s3 = cornell();
     LatentModel resumed(s3, Parameterisation::Paper, 99);  // different init: the checkpoint must overwrite it
     FitState st = load_checkpoint(ckpt, resumed);

@@ -130,7 +130,7 @@ TEST(HuberLoss, QuadraticAndLinearRegions) {
     const std::vector<float> t = {0.0f, 1.0f, -2.0f, 0.5f};
     const std::vector<float> quad = {0.5f, 0.75f, -1.9f, -0.4f};  // r = .5, -.25, .1, -.9
     EXPECT_NEAR(huber_loss(quad.data(), t.data(), 4), 0.5 * (0.25 + 0.0625 + 0.01 + 0.81) / 4, 1e-7);
-    const std::vector<float> lin = {2.0f, -2.5f, 1.0f, 0.5f};     // r = 2, -3.5, 3, 0
+    const std::vector<float> lin = {2.0f, -2.5f, 1.0f, 0.5f};  // r = 2, -3.5, 3, 0
     EXPECT_NEAR(huber_loss(lin.data(), t.data(), 4), (1.5 + 3.0 + 2.5 + 0.0) / 4, 1e-7);
     // delta = 0.5: r = 2 → 0.5 (2 − 0.25); r = 0.25 → 0.5 · 0.0625
     const std::vector<float> p2 = {2.0f, 1.25f}, t2 = {0.0f, 1.0f};
@@ -148,7 +148,8 @@ TEST(HuberLoss, GradientMatchesCentralDifferences) {
     std::vector<float> pred(n), target(n), d_huber(n), d_mse(n);
     for (size_t i = 0; i < n; ++i) {
         target[i] = u(rng);
-        do pred[i] = u(rng); while (std::fabs(std::fabs(pred[i] - target[i]) - 1.0f) < 0.01f);
+        do pred[i] = u(rng);
+        while (std::fabs(std::fabs(pred[i] - target[i]) - 1.0f) < 0.01f);
     }
     huber_loss(pred.data(), target.data(), n, 1.0f, d_huber.data());
     mse_loss(pred.data(), target.data(), n, d_mse.data());
@@ -308,7 +309,9 @@ TEST(CosineWarmRestarts, TMultTwoDoublesSecondPeriod) {
 }
 
 TEST(CosineWarmRestarts, MatchesPyTorchFormula) {
-    struct Case { int t0, t_mult; };
+    struct Case {
+        int t0, t_mult;
+    };
     for (Case c : {Case{500, 1}, Case{100, 2}, Case{7, 3}, Case{50, 4}})
         for (int it : {0, 1, 37, 123, 333, 499, 501, 777, 1234, 5003, 99999}) {
             const double ref = pytorch_sgdr(0.03, 0.001, c.t0, c.t_mult, it);

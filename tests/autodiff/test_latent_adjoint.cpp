@@ -20,7 +20,10 @@ namespace {
 
 Scene small_cornell(int max_depth = 4) {
     return load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
-                      {{"camera.width", "8"}, {"camera.height", "8"}, {"integrator.max_depth", std::to_string(max_depth)}, {"integrator.rr_depth", "100"}});
+                      {{"camera.width", "8"},
+                       {"camera.height", "8"},
+                       {"integrator.max_depth", std::to_string(max_depth)},
+                       {"integrator.rr_depth", "100"}});
 }
 
 RenderOptions opts(const Scene& s) {
@@ -46,12 +49,16 @@ double loss(LatentModel& m, const RenderOptions& o, const std::vector<float>& w)
 /// floor of 1e-2 of the largest derivative so that rounding in near-zero ones does not count.
 /// `nonzero_fraction`: share of checks whose derivative must be non-negligible (a scene that
 /// does not exercise its parameters proves nothing). Returns the slices with one, by name.
-std::set<std::string> check_all_slices(LatentModel& m, const RenderOptions& o, double tol, double nonzero_fraction = 0.5) {
+std::set<std::string> check_all_slices(LatentModel& m, const RenderOptions& o, double tol,
+                                       double nonzero_fraction = 0.5) {
     const std::vector<float> w = weights(size_t(m.scene().camera.width) * m.scene().camera.height * kLatentChannels);
     m.params().zero_grad();
     backward_latent(m, o, w);
     const std::vector<float> grad = m.params().grad_values();
-    struct Check { std::string what; double g, fd; };
+    struct Check {
+        std::string what;
+        double g, fd;
+    };
     std::vector<Check> checks;
     for (size_t si = 0; si < m.params().slice_count(); ++si) {
         const ParamSlice& sl = m.params().slice(int(si));
@@ -69,7 +76,8 @@ std::set<std::string> check_all_slices(LatentModel& m, const RenderOptions& o, d
             double lm = loss(m, o, w);
             v[c] = v0;
             m.params().set_value(int(si), v.data());
-            checks.push_back({sl.name + " channel " + std::to_string(c), grad[sl.value_offset + c], (lp - lm) / (2.0 * h)});
+            checks.push_back(
+                {sl.name + " channel " + std::to_string(c), grad[sl.value_offset + c], (lp - lm) / (2.0 * h)});
         }
     }
     m.sync();
@@ -86,7 +94,8 @@ std::set<std::string> check_all_slices(LatentModel& m, const RenderOptions& o, d
             exercised.insert(k.what.substr(0, k.what.find(" channel")));
         }
     }
-    EXPECT_GT(nonzero, int(nonzero_fraction * double(checks.size()))) << "most derivatives are ~0: the scene does not exercise the parameters";
+    EXPECT_GT(nonzero, int(nonzero_fraction * double(checks.size())))
+        << "most derivatives are ~0: the scene does not exercise the parameters";
     return exercised;
 }
 
@@ -183,8 +192,11 @@ TEST(LatentAdjoint, RoughnessGradientMatchesFiniteDifferencesInExpectation) {
     // seed's finite difference (sampling moves) differ; both are unbiased for d E[loss]/d alpha.
     // Compare their means over seeds within 4 standard errors, and require the standard error to
     // be small enough (< 25% of the value) for the comparison to mean something.
-    Scene scene = load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
-                             {{"camera.width", "16"}, {"camera.height", "16"}, {"integrator.max_depth", "3"}, {"integrator.rr_depth", "100"}});
+    Scene scene =
+        load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json", {{"camera.width", "16"},
+                                                                                    {"camera.height", "16"},
+                                                                                    {"integrator.max_depth", "3"},
+                                                                                    {"integrator.rr_depth", "100"}});
     Props rough;
     rough.type = "roughconductor";
     rough.file = "test";
@@ -224,7 +236,8 @@ TEST(LatentAdjoint, RoughnessGradientMatchesFiniteDifferencesInExpectation) {
     };
     auto [mp, sp] = mean_se(prb);
     auto [mf, sf] = mean_se(fd);
-    std::cout << "d loss / d alpha: replay " << mp << " +- " << sp << ", finite differences " << mf << " +- " << sf << "\n";
+    std::cout << "d loss / d alpha: replay " << mp << " +- " << sp << ", finite differences " << mf << " +- " << sf
+              << "\n";
     EXPECT_NEAR(mp, mf, 4 * std::hypot(sp, sf));
     EXPECT_LT(std::hypot(sp, sf), 0.25 * std::abs(mf)) << "too noisy to detect a wrong derivative";
 }
@@ -238,7 +251,9 @@ namespace {
 Scene textured_scene() {
     // 4 x 4 linear-RGB texture with distinct luminances (EXR: no sRGB decoding).
     Image tex{4, 4, 3, {}, {"R", "G", "B"}};
-    for (int i = 0; i < 16; ++i) tex.data.insert(tex.data.end(), {0.1f + 0.05f * float(i), 0.8f - 0.04f * float(i), 0.3f + 0.02f * float(i % 5)});
+    for (int i = 0; i < 16; ++i)
+        tex.data.insert(tex.data.end(),
+                        {0.1f + 0.05f * float(i), 0.8f - 0.04f * float(i), 0.3f + 0.02f * float(i % 5)});
     const std::string tex_path = test::write_temp_file("latent_tex.exr", "");
     write_exr(tex_path, tex);
     const std::string json = R"({
@@ -246,16 +261,19 @@ Scene textured_scene() {
       "camera": { "fov": 50, "width": 8, "height": 8,
                   "to_world": { "lookat": { "origin": [0, 1.2, 3.5], "target": [0, 0.4, 0], "up": [0, 1, 0] } } },
       "materials": {
-        "floor": { "type": "diffuse", "reflectance": { "type": "bitmap", "filename": ")" + tex_path + R"(" } },
+        "floor": { "type": "diffuse", "reflectance": { "type": "bitmap", "filename": ")" +
+                             tex_path + R"(" } },
         "wall": { "type": "roughplastic", "alpha": 0.3, "nonlinear": true,
-                  "diffuse_reflectance": { "type": "bitmap", "filename": ")" + tex_path + R"(", "filter_type": "nearest" } } },
+                  "diffuse_reflectance": { "type": "bitmap", "filename": ")" +
+                             tex_path + R"(", "filter_type": "nearest" } } },
       "shapes": [
         { "id": "floor", "type": "rectangle", "material": "floor", "to_world": [ { "rotate": { "axis": [1, 0, 0], "angle": -90 } }, { "scale": 1.5 } ] },
         { "id": "wall", "type": "rectangle", "material": "wall", "to_world": [ { "scale": 1.5 }, { "translate": [0, 1.5, -1.5] } ] },
         { "id": "light", "type": "rectangle", "material": { "type": "diffuse", "reflectance": 0 },
           "to_world": [ { "rotate": { "axis": [1, 0, 0], "angle": 90 } }, { "scale": 0.5 }, { "translate": [0, 2.5, 0] } ],
           "emitter": { "type": "area", "radiance": 5 } } ],
-      "emitters": [ { "type": "envmap", "filename": ")" + tex_path + R"(", "scale": 2 } ]
+      "emitters": [ { "type": "envmap", "filename": ")" +
+                             tex_path + R"(", "scale": 2 } ]
     })";
     return load_scene(test::write_temp_file("textured.json", json));
 }
@@ -263,15 +281,16 @@ Scene textured_scene() {
 }  // namespace
 
 // Textured latent colours ρ = g(uv)·s + o: the scale and offset slices exist in place of the
-// plain colour, and their path-replay gradients (and the environment map's L̃e) (diffuse, and nonlinear roughplastic whose
-// ∂ρ̃/∂ρ depends on the hit's ρ) match central differences like every other parameter.
+// plain colour, and their path-replay gradients (and the environment map's L̃e) (diffuse, and nonlinear roughplastic
+// whose ∂ρ̃/∂ρ depends on the hit's ρ) match central differences like every other parameter.
 TEST(LatentAdjoint, TextureAndEnvMapGradientsMatchFiniteDifferences) {
     Scene scene = textured_scene();
     LatentModel m(scene, Parameterisation::Code, 4);
     std::vector<std::string> names;
     for (size_t i = 0; i < m.params().slice_count(); ++i) names.push_back(m.params().slice(int(i)).name);
-    for (const char* want : {"floor.bsdf.reflectance.scale", "floor.bsdf.reflectance.offset", "wall.bsdf.diffuse_reflectance.scale",
-                             "wall.bsdf.diffuse_reflectance.offset", "wall.bsdf.specular_reflectance"})
+    for (const char* want :
+         {"floor.bsdf.reflectance.scale", "floor.bsdf.reflectance.offset", "wall.bsdf.diffuse_reflectance.scale",
+          "wall.bsdf.diffuse_reflectance.offset", "wall.bsdf.specular_reflectance"})
         EXPECT_NE(std::find(names.begin(), names.end(), want), names.end()) << want;
     EXPECT_EQ(std::find(names.begin(), names.end(), "floor.bsdf.reflectance"), names.end());
     // A bright light (Code init is U[-0.1, 0.1]) so reflected light is not lost next to L̃a.
@@ -286,7 +305,8 @@ TEST(LatentAdjoint, TextureAndEnvMapGradientsMatchFiniteDifferences) {
     o.spp = 8;
     // The light is out of view (its L̃a, L̃c, colour have no effect): judge the texture slices.
     const std::set<std::string> exercised = check_all_slices(m, o, 1e-3, 0.25);
-    for (const char* want : {"floor.bsdf.reflectance.scale", "floor.bsdf.reflectance.offset", "wall.bsdf.diffuse_reflectance.scale",
-                             "wall.bsdf.diffuse_reflectance.offset", "environment.Le"})
+    for (const char* want :
+         {"floor.bsdf.reflectance.scale", "floor.bsdf.reflectance.offset", "wall.bsdf.diffuse_reflectance.scale",
+          "wall.bsdf.diffuse_reflectance.offset", "environment.Le"})
         EXPECT_TRUE(exercised.count(want)) << want << " has only ~0 derivatives";
 }

@@ -20,8 +20,11 @@ namespace {
 Scene mixed_cornell() {
     // Russian roulette off: its survival probability depends on |β|, so a parameter change
     // would change which paths exist (fit --reuse-paths keeps q as recorded instead).
-    Scene s = load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
-                         {{"camera.width", "12"}, {"camera.height", "12"}, {"integrator.max_depth", "6"}, {"integrator.rr_depth", "100"}});
+    Scene s =
+        load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json", {{"camera.width", "12"},
+                                                                                    {"camera.height", "12"},
+                                                                                    {"integrator.max_depth", "6"},
+                                                                                    {"integrator.rr_depth", "100"}});
     auto assign = [&](const std::string& shape, const std::string& type, float alpha) {
         Props p;
         p.type = type;
@@ -96,8 +99,9 @@ TEST(PathRecord, RecordsStayValidAfterParameterSteps) {
         const ParamSlice& sl = ps.slice(int(si));
         if (sl.channels != kLatentChannels) continue;
         std::vector<float> v(ps.value(int(si)), ps.value(int(si)) + sl.channels);
-        for (int c = 0; c < sl.channels; ++c) v[c] = sl.kind == "reflectance" ? 0.2f + 0.6f * sample_1d(9, uint32_t(si), uint32_t(c), 0)
-                                                                               : 2.f * sample_1d(9, uint32_t(si), uint32_t(c), 1) - 1.f;
+        for (int c = 0; c < sl.channels; ++c)
+            v[c] = sl.kind == "reflectance" ? 0.2f + 0.6f * sample_1d(9, uint32_t(si), uint32_t(c), 0)
+                                            : 2.f * sample_1d(9, uint32_t(si), uint32_t(c), 1) - 1.f;
         ps.set_value(int(si), v.data());
     }
     m.sync();
@@ -166,7 +170,8 @@ TEST(PathRecord, AnObserverDoesNotChangeThePrimal) {
     m.sync();
     const RenderOptions o = opts(scene);
     RenderStats plain_stats, recorded_stats;
-    const std::vector<float> plain = render_latent_terms<kLatentChannels>(scene, m.spectra(), m.terms(), o, &plain_stats).sum();
+    const std::vector<float> plain =
+        render_latent_terms<kLatentChannels>(scene, m.spectra(), m.terms(), o, &plain_stats).sum();
     std::vector<float> recorded;
     record_latent_paths(m, o, &recorded, &recorded_stats);
     ASSERT_EQ(plain.size(), recorded.size());

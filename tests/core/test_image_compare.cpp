@@ -12,8 +12,8 @@ namespace {
 
 /// K renders of a smooth image (a ramp with an edge, so blocks differ in level) with Gaussian
 /// pixel noise of relative size `noise`, scaled by `gain` inside the rectangle [x0, x1) x [y0, y1).
-RenderStack noisy_stack(int w, int h, int k, double noise, uint32_t seed, double gain = 1.0, int x0 = 0, int x1 = 0, int y0 = 0,
-                        int y1 = 0) {
+RenderStack noisy_stack(int w, int h, int k, double noise, uint32_t seed, double gain = 1.0, int x0 = 0, int x1 = 0,
+                        int y0 = 0, int y1 = 0) {
     std::mt19937 rng(seed);
     std::normal_distribution<double> gauss(0.0, 1.0);
     RenderStack s;

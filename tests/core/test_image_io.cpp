@@ -21,5 +21,6 @@ TEST(ImageIo, SixteenChannelExrKeepsChannelOrder) {
     EXPECT_EQ(back.data, img.data);
     EXPECT_EQ(back.channel_names[10], "C10");
     // No temp files left behind by the atomic writes.
-    for (const auto& e : std::filesystem::directory_iterator(dir)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }

@@ -41,7 +41,8 @@ TEST(SceneEdit, ShapesMoveAboutTheirCentreAndFramesDoNotAccumulate) {
     const Camera cam = s.camera;
     EditSequence e = load_edits(test::write_temp_file("e1.json", R"({"frames": 2, "shapes": [
         {"id": "light", "translate": [[0, 0, 0], [1, 0, 0]]},
-        {"id": "tall_block", "rotate": {"axis": [0, 1, 0], "angle": [0, 90]}, "scale": 2}]})"), s);
+        {"id": "tall_block", "rotate": {"axis": [0, 1, 0], "angle": [0, 90]}, "scale": 2}]})"),
+                                s);
     const int light = s.find_shape("light"), tall = s.find_shape("tall_block");
     const Vec3f c_light = centroid(original[light]);
     const float area_tall = s.shapes[tall].area();
@@ -56,7 +57,9 @@ TEST(SceneEdit, ShapesMoveAboutTheirCentreAndFramesDoNotAccumulate) {
     const Vec3f c = box.center();
     const Eigen::Matrix3f r = Eigen::AngleAxisf(kPi / 4, Vec3f::UnitY()).toRotationMatrix();
     for (size_t k = 0; k < original[tall].positions.size(); ++k)
-        EXPECT_LT((s.shapes[tall].mesh.positions[k] - (c + r * (2.f * (original[tall].positions[k] - c)))).norm(), 1e-4f) << k;
+        EXPECT_LT((s.shapes[tall].mesh.positions[k] - (c + r * (2.f * (original[tall].positions[k] - c)))).norm(),
+                  1e-4f)
+            << k;
     apply_edits(e, 0.f, original, cam, s);
     EXPECT_EQ(s.shapes[light].mesh.positions, original[light].positions);
 }
@@ -66,7 +69,8 @@ TEST(SceneEdit, OrbitKeepsDistanceToPivotAndTurnsByTheAngle) {
     std::vector<TriangleMesh> original;
     for (const Shape& sh : s.shapes) original.push_back(sh.mesh);
     const Camera cam = s.camera;
-    EditSequence e = load_edits(test::write_temp_file("e2.json", R"({"camera": {"orbit": {"azimuth": 90, "pivot": [2.78, 2.73, 2.8]}}})"), s);
+    EditSequence e = load_edits(
+        test::write_temp_file("e2.json", R"({"camera": {"orbit": {"azimuth": 90, "pivot": [2.78, 2.73, 2.8]}}})"), s);
     apply_edits(e, 0.f, original, cam, s);
     const Vec3f pivot(2.78f, 2.73f, 2.8f);
     const Vec3f o0 = cam.world_from_camera.point(Vec3f::Zero()), o1 = s.camera.world_from_camera.point(Vec3f::Zero());
@@ -80,7 +84,8 @@ TEST(SceneEdit, ErrorsNameFileAndField) {
     EXPECT_NE(err.find("edits.json"), std::string::npos) << err;
     EXPECT_NE(err.find("shapes[0].id"), std::string::npos) << err;
     EXPECT_NE(err.find("teapot"), std::string::npos) << err;
-    EXPECT_NE(edit_error(s, R"({"shapes": [{"id": "light", "translate": [1, 0]}]})").find("shapes[0].translate"), std::string::npos);
+    EXPECT_NE(edit_error(s, R"({"shapes": [{"id": "light", "translate": [1, 0]}]})").find("shapes[0].translate"),
+              std::string::npos);
     EXPECT_NE(edit_error(s, R"({"shapes": [{"id": "light", "spin": 3}]})").find("shapes[0].spin"), std::string::npos);
     EXPECT_NE(edit_error(s, R"({"frames": 0})").find("frames"), std::string::npos);
     EXPECT_NE(edit_error(s, R"({"camera": {"zoom": 2}})").find("camera"), std::string::npos);

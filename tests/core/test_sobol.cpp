@@ -100,13 +100,15 @@ TEST(Sobol, PairsAndPixelsAreNotCorrelated) {
                     std::vector<int> cnt(64, 0);
                     double sx = 0, sy = 0, sxy = 0, sxx = 0, syy = 0;
                     for (uint32_t i = 0; i < 1024; ++i) {
-                        const double x = sobol_sample(key, i, pairs[p].first), y = sobol_sample(cross_pixel ? other : key, i, pairs[q].second);
+                        const double x = sobol_sample(key, i, pairs[p].first),
+                                     y = sobol_sample(cross_pixel ? other : key, i, pairs[q].second);
                         ++cnt[size_t(x * 8) * 8 + size_t(y * 8)];
                         sx += x, sy += y, sxy += x * y, sxx += x * x, syy += y * y;
                     }
                     double chi2 = 0;
                     for (int k : cnt) chi2 += (k - 16.0) * (k - 16.0) / 16.0;
-                    const double n = 1024, r = (sxy / n - sx * sy / (n * n)) / std::sqrt((sxx / n - sx * sx / (n * n)) * (syy / n - sy * sy / (n * n)));
+                    const double n = 1024, r = (sxy / n - sx * sy / (n * n)) /
+                                               std::sqrt((sxx / n - sx * sx / (n * n)) * (syy / n - sy * sy / (n * n)));
                     sum += chi2, worst = std::max(worst, chi2), worst_r = std::max(worst_r, std::abs(r));
                     ++cases;
                 }
@@ -165,5 +167,6 @@ TEST(Sobol, StreamsArePureFunctions) {
             }
         }
     }
-    EXPECT_EQ(SampleStream(9, 1, 2, SamplerKind::Independent).get(5), sample_1d(9, 1, 2, 5)) << "independent sampler unchanged";
+    EXPECT_EQ(SampleStream(9, 1, 2, SamplerKind::Independent).get(5), sample_1d(9, 1, 2, 5))
+        << "independent sampler unchanged";
 }

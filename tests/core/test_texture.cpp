@@ -43,7 +43,8 @@ std::string write_png8(const std::string& name, int w, int h, int channels, cons
     EXPECT_TRUE(out);
     OIIO::ImageSpec spec(w, h, channels, OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:UnassociatedAlpha", 1);
-    EXPECT_TRUE(out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, data.data()) && out->close()) << out->geterror();
+    EXPECT_TRUE(out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, data.data()) && out->close())
+        << out->geterror();
     return path;
 }
 
@@ -59,9 +60,12 @@ std::string error_of(const std::function<void()>& f) {
     }
     return "";
 }
-void expect_has(const std::string& err, const std::string& part) { EXPECT_NE(err.find(part), std::string::npos) << "'" << part << "' not in: " << err; }
+void expect_has(const std::string& err, const std::string& part) {
+    EXPECT_NE(err.find(part), std::string::npos) << "'" << part << "' not in: " << err;
+}
 
-std::shared_ptr<Props> bitmap_props(const std::string& file, const std::string& filter = "", const std::string& wrap = "") {
+std::shared_ptr<Props> bitmap_props(const std::string& file, const std::string& filter = "",
+                                    const std::string& wrap = "") {
     auto t = std::make_shared<Props>();
     t->type = "bitmap";
     t->values["filename"] = file;
@@ -70,7 +74,9 @@ std::shared_ptr<Props> bitmap_props(const std::string& file, const std::string& 
     return t;
 }
 
-Texture load(const std::string& path, TextureFilter f, TextureWrap w) { return Texture::load_bitmap(path, false, f, w); }
+Texture load(const std::string& path, TextureFilter f, TextureWrap w) {
+    return Texture::load_bitmap(path, false, f, w);
+}
 
 }  // namespace
 
@@ -106,7 +112,7 @@ TEST(Texture, WrapModesOutsideTheUnitSquare) {
     // u = 1.375: columns 2 and 3 with weights 0.75 / 0.25.
     expect_rgb(rep.eval({1.375f, 0.25f}), Eigen::Array3f(0.75f, 0.25f, 0.f));  // 2 -> 0, 3 -> 1
     expect_rgb(mir.eval({1.375f, 0.25f}), Eigen::Array3f(0.25f, 0.75f, 0.f));  // 2 -> 1, 3 -> 0
-    expect_rgb(cla.eval({1.375f, 0.25f}), kGreen);                            // both -> 1
+    expect_rgb(cla.eval({1.375f, 0.25f}), kGreen);                             // both -> 1
     // Negative coordinates.
     expect_rgb(rep.eval({-0.25f, 0.25f}), kGreen);
     expect_rgb(mir.eval({-0.25f, 0.25f}), kRed);
@@ -176,7 +182,8 @@ TEST(Texture, MissingOrBadFilesNameTheFile) {
 
     // Through a scene file: the error also names the shapes that use the material.
     const std::string scene = test::write_temp_file("missing_tex.json", R"({"camera": {"fov": 40},
-      "materials": {"wood": {"type": "diffuse", "reflectance": {"type": "bitmap", "filename": ")" + missing + R"("}}},
+      "materials": {"wood": {"type": "diffuse", "reflectance": {"type": "bitmap", "filename": ")" +
+                                                                            missing + R"("}}},
       "shapes": [{"id": "desk", "type": "rectangle", "material": "wood"}, {"id": "chair", "type": "rectangle", "material": "wood"}]})");
     err = error_of([&] { load_scene(scene); });
     expect_has(err, "missing_tex.json");
@@ -209,12 +216,15 @@ TEST(Texture, FromProps) {
     owner.type = "diffuse";
     owner.file = temp_path("scene.json");
     owner.where = "materials.m";
-    expect_rgb(texture_from_props(owner, "reflectance", Eigen::Array3f::Constant(0.5f)).eval({0, 0}), Eigen::Array3f::Constant(0.5f));
+    expect_rgb(texture_from_props(owner, "reflectance", Eigen::Array3f::Constant(0.5f)).eval({0, 0}),
+               Eigen::Array3f::Constant(0.5f));
     owner.values["reflectance"] = 0.25f;
     EXPECT_TRUE(texture_from_props(owner, "reflectance", Eigen::Array3f::Zero()).is_constant());
-    expect_rgb(texture_from_props(owner, "reflectance", Eigen::Array3f::Zero()).mean(), Eigen::Array3f::Constant(0.25f));
+    expect_rgb(texture_from_props(owner, "reflectance", Eigen::Array3f::Zero()).mean(),
+               Eigen::Array3f::Constant(0.25f));
     owner.values["reflectance"] = Eigen::Array3f(0.1f, 0.2f, 0.3f);
-    expect_rgb(texture_from_props(owner, "reflectance", Eigen::Array3f::Zero()).eval({0, 0}), Eigen::Array3f(0.1f, 0.2f, 0.3f));
+    expect_rgb(texture_from_props(owner, "reflectance", Eigen::Array3f::Zero()).eval({0, 0}),
+               Eigen::Array3f(0.1f, 0.2f, 0.3f));
 
     // A relative filename is taken relative to the owner's file.
     write_quad_exr("rel.exr");
@@ -314,7 +324,8 @@ TEST(Texture, JsonSceneResolvesFilenamesAndNamesUnsupportedUses) {
         return R"({"camera": {"width": 4, "height": 4}, "materials": {"wood": )" + material +
                R"(}, "shapes": [{"type": "rectangle", "material": "wood"}]})";
     };
-    std::string path = test::write_temp_file("textured.json", scene_json(R"({"type": "twosided", "bsdf": {"type": "diffuse",
+    std::string path =
+        test::write_temp_file("textured.json", scene_json(R"({"type": "twosided", "bsdf": {"type": "diffuse",
         "reflectance": {"type": "bitmap", "filename": "json-tex.exr", "raw": false, "filter_type": "nearest"}}})"));
     Scene s = load_scene(path);
     auto tex = s.materials[0].get_child("bsdf")->get_child("reflectance");
@@ -348,7 +359,8 @@ TEST(Texture, PlasticsWithBitmapDiffuseEqualTheConstantAtThatTexel) {
             expect_rgb(a->eval(ctx, wi, wo), b->eval(ctx, wi, wo));
             expect_rgb(a->albedo(ctx), b->albedo(ctx));
             for (float u1 : {0.1f, 0.9f}) {
-                BSDFSample<3> sa = a->sample(ctx, wi, u1, Vec2f(0.3f, 0.7f)), sb = b->sample(ctx, wi, u1, Vec2f(0.3f, 0.7f));
+                BSDFSample<3> sa = a->sample(ctx, wi, u1, Vec2f(0.3f, 0.7f)),
+                              sb = b->sample(ctx, wi, u1, Vec2f(0.3f, 0.7f));
                 ASSERT_EQ(sa.valid(), sb.valid());
                 if (sa.valid()) expect_rgb(sa.weight, sb.weight);
             }

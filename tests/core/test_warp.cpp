@@ -45,7 +45,8 @@ TEST(Warp, CosineHemisphereHistogramInCosTheta) {
     const int bins = 16, n = 1 << 18;
     std::vector<int> h(bins, 0);
     for (int i = 0; i < n; ++i) {
-        const Vec3f w = sample_cosine_hemisphere(Vec2f(sample_1d(5, uint32_t(i), 0, 0), sample_1d(5, uint32_t(i), 0, 1)));
+        const Vec3f w =
+            sample_cosine_hemisphere(Vec2f(sample_1d(5, uint32_t(i), 0, 0), sample_1d(5, uint32_t(i), 0, 1)));
         ASSERT_NEAR(w.norm(), 1.f, 1e-5f);
         ASSERT_GE(w.z(), 0.f);
         ++h[std::min(bins - 1, int(w.z() * bins))];

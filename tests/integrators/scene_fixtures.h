@@ -11,11 +11,14 @@ namespace lpt::test {
 inline Scene furnace_scene(float albedo, float le, int max_depth = -1) {
     std::string a = std::to_string(albedo), l = std::to_string(le);
     std::string json = R"({
-      "integrator": {"max_depth": )" + std::to_string(max_depth) + R"(, "rr_depth": 3},
+      "integrator": {"max_depth": )" +
+                       std::to_string(max_depth) + R"(, "rr_depth": 3},
       "camera": {"fov": 60, "width": 8, "height": 8, "to_world": {"lookat": {"origin": [0,0,0], "target": [0,0,1], "up": [0,1,0]}}},
-      "materials": {"wall": {"type": "diffuse", "reflectance": )" + a + R"(}},
+      "materials": {"wall": {"type": "diffuse", "reflectance": )" +
+                       a + R"(}},
       "shapes": [{"id": "shell", "type": "sphere", "material": "wall", "flip_normals": true,
-                  "emitter": {"type": "area", "radiance": )" + l + R"(}}]
+                  "emitter": {"type": "area", "radiance": )" +
+                       l + R"(}}]
     })";
     return load_scene(write_temp_file("furnace.json", json));
 }
@@ -28,14 +31,19 @@ inline Scene form_factor_scene(float rho, float le, float a, float b, float h) {
     std::string json = R"({
       "integrator": {"max_depth": 2, "rr_depth": 100},
       "camera": {"fov": 0.5, "width": 8, "height": 8, "filter": {"type": "box"}, "near_clip": 1e-4,
-                 "to_world": {"lookat": {"origin": [0,0,)" + s(h / 2) + R"(], "target": [0,0,0], "up": [0,1,0]}}},
-      "materials": {"plane": {"type": "diffuse", "reflectance": )" + s(rho) + R"(},
+                 "to_world": {"lookat": {"origin": [0,0,)" +
+                       s(h / 2) + R"(], "target": [0,0,0], "up": [0,1,0]}}},
+      "materials": {"plane": {"type": "diffuse", "reflectance": )" +
+                       s(rho) + R"(},
                     "black": {"type": "diffuse", "reflectance": 0}},
       "shapes": [
         {"id": "plane", "type": "rectangle", "material": "plane", "to_world": {"scale": [100, 100, 1]}},
         {"id": "light", "type": "rectangle", "material": "black",
-         "to_world": [{"scale": [)" + s(a) + "," + s(b) + R"(, 1]}, {"rotate": {"axis": [1,0,0], "angle": 180}}, {"translate": [0,0,)" + s(h) + R"(]}],
-         "emitter": {"type": "area", "radiance": )" + s(le) + R"(}}]
+         "to_world": [{"scale": [)" +
+                       s(a) + "," + s(b) +
+                       R"(, 1]}, {"rotate": {"axis": [1,0,0], "angle": 180}}, {"translate": [0,0,)" + s(h) + R"(]}],
+         "emitter": {"type": "area", "radiance": )" +
+                       s(le) + R"(}}]
     })";
     return load_scene(write_temp_file("form_factor.json", json));
 }

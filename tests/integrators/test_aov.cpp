@@ -27,7 +27,8 @@ TEST(Aov, PlaneNormalDistanceAlbedoAtAnyResolution) {
 
 TEST(Aov, MissGivesZero) {
     Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 2.f);
-    scene.camera.world_from_camera = Transform::look_at(Vec3f(0, 0, 1), Vec3f(0, 0, 5), Vec3f(0, 1, 0));  // looking up, past the light
+    scene.camera.world_from_camera =
+        Transform::look_at(Vec3f(0, 0, 1), Vec3f(0, 0, 5), Vec3f(0, 1, 0));  // looking up, past the light
     scene.shapes.erase(scene.shapes.begin() + scene.find_shape("light"));
     scene.emitters.clear();
     scene.build();

@@ -100,7 +100,8 @@ TEST(EnvMap, ConstantMapEqualsConstantEmitter) {
         })"));
     };
     Scene constant = scene_with(R"({"type": "constant", "radiance": 0.8})");
-    Scene envmap = scene_with(R"({"type": "envmap", "filename": ")" + map + R"(", "to_world": {"rotate": {"axis": [1,1,0], "angle": 70}}})");
+    Scene envmap = scene_with(R"({"type": "envmap", "filename": ")" + map +
+                              R"(", "to_world": {"rotate": {"axis": [1,1,0], "angle": 70}}})");
     for (LightStrategy s : {LightStrategy::Mis, LightStrategy::Nee, LightStrategy::Bsdf}) {
         const std::vector<float> a = render(constant, 64, s), b = render(envmap, 64, s);
         // The tessellated sphere's silhouette pixels mix sky and ball identically in both.
@@ -121,9 +122,8 @@ TEST(EnvMap, SingleTexelIsADirectionalLight) {
     // +y) seen from above: L_o = (albedo / π) · E, E = 500 ∫_texel max(0, n·ω) dω.
     const int W = 32, H = 16, ti = 5, tj = 4;
     const float Lt = 500.f, albedo = 0.6f;
-    const std::string map = write_map("texel_sky.exr", W, H, [&](int i, int j) {
-        return Eigen::Array3f::Constant(i == ti && j == tj ? Lt : 0.f);
-    });
+    const std::string map = write_map(
+        "texel_sky.exr", W, H, [&](int i, int j) { return Eigen::Array3f::Constant(i == ti && j == tj ? Lt : 0.f); });
     // Quadrature over the texel in (u, v): dω = 2π² sin θ du dv; ω_y = cos θ (identity to_world).
     double E = 0;
     const int q = 400;
@@ -151,7 +151,8 @@ TEST(EnvMap, SingleTexelIsADirectionalLight) {
 }
 
 TEST(EnvMap, MissingMapNamesTheFile) {
-    const std::string json = R"({"camera": {"fov": 40}, "shapes": [], "emitters": [{"type": "envmap", "filename": "no_such_sky.exr"}]})";
+    const std::string json =
+        R"({"camera": {"fov": 40}, "shapes": [], "emitters": [{"type": "envmap", "filename": "no_such_sky.exr"}]})";
     try {
         load_scene(write_temp_file("env_missing.json", json));
         FAIL() << "accepted a missing map";

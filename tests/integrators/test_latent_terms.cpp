@@ -97,7 +97,8 @@ TEST(LatentTerms, AmbientIsLaAtTheFirstDiffuseVertex) {
 
 TEST(LatentTerms, BackgroundForEscapingCameraRays) {
     Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 1.f);
-    scene.camera.world_from_camera = Transform::look_at(Vec3f(5, 5, 5), Vec3f(10, 10, 10), Vec3f(0, 0, 1));  // looks at the sky
+    scene.camera.world_from_camera =
+        Transform::look_at(Vec3f(5, 5, 5), Vec3f(10, 10, 10), Vec3f(0, 0, 1));  // looks at the sky
     auto spectra = SceneSpectra<16>::from_description(scene);
     LatentTerms<16> t = zero_terms(scene);
     t.background = ramp(0.2f, -0.6f);

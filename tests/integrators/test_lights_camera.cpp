@@ -15,7 +15,8 @@ TEST(AreaLight, SamplePdfMatchesPdfAreaLight) {
     const Shape& light = scene.shapes[scene.find_shape("light")];
     Vec3f ref(0.1f, -0.2f, 0.f);
     for (uint32_t i = 0; i < 1000; ++i) {
-        LightSample ls = sample_area_light(light, ref, Eigen::Vector3f(sample_1d(1, i, 0, 0), sample_1d(1, i, 0, 1), sample_1d(1, i, 0, 2)));
+        LightSample ls = sample_area_light(
+            light, ref, Eigen::Vector3f(sample_1d(1, i, 0, 0), sample_1d(1, i, 0, 1), sample_1d(1, i, 0, 2)));
         ASSERT_TRUE(ls.valid());
         EXPECT_NEAR(ls.pdf, pdf_area_light(light, ref, ls.p, ls.n), 1e-4f * ls.pdf);
     }
@@ -30,7 +31,8 @@ TEST(AreaLight, InversePdfIntegratesSolidAngle) {
     double sum = 0, sum2 = 0;
     const int n = 200000;
     for (int i = 0; i < n; ++i) {
-        LightSample ls = sample_area_light(light, Vec3f::Zero(), Eigen::Vector3f(sample_1d(2, i, 0, 0), sample_1d(2, i, 0, 1), sample_1d(2, i, 0, 2)));
+        LightSample ls = sample_area_light(
+            light, Vec3f::Zero(), Eigen::Vector3f(sample_1d(2, i, 0, 0), sample_1d(2, i, 0, 1), sample_1d(2, i, 0, 2)));
         double v = ls.valid() ? 1.0 / ls.pdf : 0.0;
         sum += v;
         sum2 += v * v;
@@ -77,8 +79,12 @@ TEST(LightSampler, BatchEqualsOneByOne) {
     for (size_t k = 0; k < n; ++k) {
         const uint32_t i = uint32_t(k);
         // Mostly near the lights; every 7th reference point on the quad light itself.
-        const Vec3f r = k % 7 == 0 ? Vec3f(0.f, 0.f, 2.f) : Vec3f(4 * sample_1d(4, i, 0, 0) - 2, 4 * sample_1d(4, i, 0, 1) - 2, 3 * sample_1d(4, i, 0, 2) - 0.5f);
-        b.rx[k] = r.x(); b.ry[k] = r.y(); b.rz[k] = r.z();
+        const Vec3f r = k % 7 == 0 ? Vec3f(0.f, 0.f, 2.f)
+                                   : Vec3f(4 * sample_1d(4, i, 0, 0) - 2, 4 * sample_1d(4, i, 0, 1) - 2,
+                                           3 * sample_1d(4, i, 0, 2) - 0.5f);
+        b.rx[k] = r.x();
+        b.ry[k] = r.y();
+        b.rz[k] = r.z();
         b.u_choice[k] = sample_1d(4, i, 0, 3);
         b.u_pos0[k] = sample_1d(4, i, 0, 4);
         b.u_pos1[k] = sample_1d(4, i, 0, 5);
@@ -86,7 +92,8 @@ TEST(LightSampler, BatchEqualsOneByOne) {
     scene.lights.sample_batch(scene.emitters, scene.shapes, n, b);
     int valid = 0, kinds[3] = {0, 0, 0};
     for (size_t k = 0; k < n; ++k) {
-        const LightSample one = scene.lights.sample(scene.emitters, scene.shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]), b.u_choice[k], Vec2f(b.u_pos0[k], b.u_pos1[k]));
+        const LightSample one = scene.lights.sample(scene.emitters, scene.shapes, Vec3f(b.rx[k], b.ry[k], b.rz[k]),
+                                                    b.u_choice[k], Vec2f(b.u_pos0[k], b.u_pos1[k]));
         const LightSample got = b.get(k);
         ASSERT_EQ(got.emitter, one.emitter) << k;
         ASSERT_EQ(got.pdf, one.pdf) << k;
@@ -112,7 +119,8 @@ TEST(Camera, BatchRaysEqualOneByOne) {
     Camera cam;
     Eigen::Matrix4f scale = Eigen::Matrix4f::Identity();
     scale.diagonal() << 1.5f, 1.5f, 1.5f, 1.f;
-    cam.world_from_camera = Transform::look_at(Vec3f(1, 2, 3), Vec3f(0, 0.5f, -1), Vec3f(0.2f, 1, 0)) * Transform(scale);
+    cam.world_from_camera =
+        Transform::look_at(Vec3f(1, 2, 3), Vec3f(0, 0.5f, -1), Vec3f(0.2f, 1, 0)) * Transform(scale);
     cam.width = 37;
     cam.height = 23;
     cam.fov = 52.f;
@@ -129,7 +137,9 @@ TEST(Camera, BatchRaysEqualOneByOne) {
             u1[k] = k == 0 ? 0.f : sample_1d(6, uint32_t(k), 0, 1);
         }
         const Vec2f th = cam.tan_half_fov();
-        cam.generate_rays(n, px.data(), py.data(), u0.data(), u1.data(), th, {o[0].data(), o[1].data(), o[2].data(), o[3].data(), o[4].data(), o[5].data(), o[6].data(), o[7].data()});
+        cam.generate_rays(
+            n, px.data(), py.data(), u0.data(), u1.data(), th,
+            {o[0].data(), o[1].data(), o[2].data(), o[3].data(), o[4].data(), o[5].data(), o[6].data(), o[7].data()});
         for (size_t k = 0; k < n; ++k) {
             const Vec2f off = cam.filter.sample(Vec2f(u0[k], u1[k]));
             const Ray r = cam.generate_ray(Vec2f(px[k] + 0.5f + off.x(), py[k] + 0.5f + off.y()), th);

@@ -32,8 +32,8 @@ Stats pixel_stats(const std::vector<float>& img, int channels, int c) {
     return {mean, std::sqrt(var / (n - 1))};
 }
 
-std::vector<float> render(const Scene& scene, int spp, uint64_t seed, LightStrategy strat = LightStrategy::Mis, int w = 0, int h = 0,
-                          SamplerKind sampler = SamplerKind::Sobol) {
+std::vector<float> render(const Scene& scene, int spp, uint64_t seed, LightStrategy strat = LightStrategy::Mis,
+                          int w = 0, int h = 0, SamplerKind sampler = SamplerKind::Sobol) {
     auto spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions opt = RenderOptions::from_scene(scene);
     opt.sampler = sampler;
@@ -78,7 +78,9 @@ TEST(PathTracer, MaxDepthTruncatesFurnaceSeries) {
 TEST(PathTracer, DirectLightingMatchesFormFactor) {
     // A small far light, and a large light close to the receiver (the second caught shadow rays
     // that re-hit the light they aimed at).
-    struct Case { float a, b, h; };
+    struct Case {
+        float a, b, h;
+    };
     for (Case k : {Case{0.5f, 0.3f, 1.f}, Case{3.f, 3.f, 0.5f}}) {
         const float rho = 0.5f, le = 3.f;
         Scene scene = form_factor_scene(rho, le, k.a, k.b, k.h);
@@ -104,7 +106,8 @@ TEST(PathTracer, NeeBsdfAndMisAgreeOnCornellBox) {
     Vec3f centre = light.mesh.positions[0];
     for (const auto& p : light.mesh.positions) centre = centre.cwiseMin(p);
     centre += 0.5f * (light.mesh.positions[2] - light.mesh.positions[0]).cwiseAbs();
-    light.mesh.transform(Transform::translate(centre) * Transform::scale(Vec3f(3, 1, 3)) * Transform::translate(-centre));
+    light.mesh.transform(Transform::translate(centre) * Transform::scale(Vec3f(3, 1, 3)) *
+                         Transform::translate(-centre));
     scene.build();
     const int w = 48, h = 48, spp = 1024;
     auto mis = render(scene, spp, 4, LightStrategy::Mis, w, h);
@@ -152,7 +155,8 @@ double form_factor_rmse_slope(SamplerKind sampler) {
         lx.push_back(std::log(double(spp)));
         ly.push_back(0.5 * std::log(mse));  // log RMSE
     }
-    double mx = std::accumulate(lx.begin(), lx.end(), 0.0) / lx.size(), my = std::accumulate(ly.begin(), ly.end(), 0.0) / ly.size();
+    double mx = std::accumulate(lx.begin(), lx.end(), 0.0) / lx.size(),
+           my = std::accumulate(ly.begin(), ly.end(), 0.0) / ly.size();
     double num = 0, den = 0;
     for (size_t i = 0; i < lx.size(); ++i) num += (lx[i] - mx) * (ly[i] - my), den += (lx[i] - mx) * (lx[i] - mx);
     return num / den;
@@ -188,7 +192,8 @@ TEST(PathTracer, SameSeedSameImageAtAnyThreadCount) {
         EXPECT_NE(0, std::memcmp(one.data(), other.data(), one.size() * sizeof(float))) << "seed must change the image";
         auto independent = render(scene, 8, 42, LightStrategy::Mis, 40, 40, SamplerKind::Independent);
         if (sampler == SamplerKind::Sobol) {
-            EXPECT_NE(0, std::memcmp(one.data(), independent.data(), one.size() * sizeof(float))) << "the sampler must change the image";
+            EXPECT_NE(0, std::memcmp(one.data(), independent.data(), one.size() * sizeof(float)))
+                << "the sampler must change the image";
         }
     }
 }

@@ -19,7 +19,8 @@ std::string flat_plane_xml(const std::string& sampler_type) {
   <integrator type="path"><integer name="max_depth" value="2"/></integrator>
   <sensor type="perspective"><float name="fov" value="30"/>
     <transform name="to_world"><lookat origin="0, 0, -3" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <sampler type=")" + sampler_type + R"("><integer name="sample_count" value="4"/></sampler>
+    <sampler type=")" +
+           sampler_type + R"("><integer name="sample_count" value="4"/></sampler>
     <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="64"/><rfilter type="box"/></film></sensor>
   <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
     <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></bsdf></shape>
@@ -57,8 +58,11 @@ double autocorrelation(const std::vector<double>& e, int w, int dx, int dy) {
 
 TEST(Samplers, XmlSamplerTypesMapToTheNearestWeHave) {
     for (const char* t : {"stratified", "multijitter", "ldsampler", "orthogonal"})
-        EXPECT_EQ(load_scene(test::write_temp_file("plane.xml", flat_plane_xml(t))).integrator.sampler, SamplerKind::Sobol) << t;
-    EXPECT_EQ(load_scene(test::write_temp_file("plane.xml", flat_plane_xml("independent"))).integrator.sampler, SamplerKind::Independent);
+        EXPECT_EQ(load_scene(test::write_temp_file("plane.xml", flat_plane_xml(t))).integrator.sampler,
+                  SamplerKind::Sobol)
+            << t;
+    EXPECT_EQ(load_scene(test::write_temp_file("plane.xml", flat_plane_xml("independent"))).integrator.sampler,
+              SamplerKind::Independent);
     EXPECT_THROW(load_scene(test::write_temp_file("plane.xml", flat_plane_xml("halton"))), std::exception);
 }
 
@@ -73,7 +77,8 @@ TEST(Samplers, FlatLitPlaneErrorImageHasNoPattern) {
         // 4096 pixels: an autocorrelation of pure noise has sd ~ 1/64; a shared scramble or a
         // pixel-periodic pattern would put it near 1 at some lag.
         for (auto [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {2, 0}, {0, 2}, {4, 0}, {8, 0}, {0, 8}, {16, 16}})
-            EXPECT_LT(std::abs(autocorrelation(e, 64, dx, dy)), 5.0 / 64.0) << sampler_name(sampler) << " lag " << dx << "," << dy;
+            EXPECT_LT(std::abs(autocorrelation(e, 64, dx, dy)), 5.0 / 64.0)
+                << sampler_name(sampler) << " lag " << dx << "," << dy;
     }
 }
 

@@ -18,13 +18,16 @@ std::vector<float> downsample(const Image& img, int f) {
     std::vector<float> out(size_t(w) * h * 3, 0.f);
     for (int y = 0; y < img.height; ++y)
         for (int x = 0; x < img.width; ++x)
-            for (int c = 0; c < 3; ++c) out[((y / f) * w + x / f) * 3 + c] += img.data[(size_t(y) * img.width + x) * img.channels + c] / float(f * f);
+            for (int c = 0; c < 3; ++c)
+                out[((y / f) * w + x / f) * 3 + c] +=
+                    img.data[(size_t(y) * img.width + x) * img.channels + c] / float(f * f);
     return out;
 }
 
 double relative_mse(const std::vector<float>& a, const std::vector<float>& ref) {
     double s = 0;
-    for (size_t i = 0; i < a.size(); ++i) s += double(a[i] - ref[i]) * (a[i] - ref[i]) / (double(ref[i]) * ref[i] + 1e-2);
+    for (size_t i = 0; i < a.size(); ++i)
+        s += double(a[i] - ref[i]) * (a[i] - ref[i]) / (double(ref[i]) * ref[i] + 1e-2);
     return s / a.size();
 }
 
@@ -34,7 +37,8 @@ TEST(Tungsten, CornellBoxConvergesToIndependentReference) {
     std::string shared = test::shared_dir();
     if (shared.empty()) GTEST_SKIP() << "../shared not found (set LATENTPT_SHARED): skipping the Tungsten validation";
     const int res = 256;
-    Scene scene = load_scene(shared + "/scenes/cornell-box/scene_v3.xml", {{"resx", std::to_string(res)}, {"resy", std::to_string(res)}});
+    Scene scene = load_scene(shared + "/scenes/cornell-box/scene_v3.xml",
+                             {{"resx", std::to_string(res)}, {"resy", std::to_string(res)}});
     scene.camera.filter = {PixelFilter::Type::Box, 0.5f};
     Image ref_full = read_image(shared + "/scenes/cornell-box/TungstenRender.exr");
     ASSERT_EQ(ref_full.width, 1024);

@@ -26,7 +26,8 @@ TEST(LatentModel, LeavesTheScenesMaterialsAsTheyWere) {
     const size_t materials = scene.materials.size();
     LatentModel model(scene, Parameterisation::Code, 3);
     EXPECT_EQ(scene.materials.size(), materials);
-    for (size_t i = 0; i < scene.shapes.size(); ++i) EXPECT_EQ(scene.shapes[i].material, before[i]) << scene.shapes[i].id;
+    for (size_t i = 0; i < scene.shapes.size(); ++i)
+        EXPECT_EQ(scene.shapes[i].material, before[i]) << scene.shapes[i].id;
 }
 
 TEST(LatentModel, ShapesSharingAMaterialLearnTheirOwnReflectance) {

@@ -64,7 +64,7 @@ TEST(ParamStore, ClampKeepsRawInRange) {
     for (float& r : ps.raw()) r = 100.f;
     ps.clamp_raw();
     EXPECT_FLOAT_EQ(ps.value(0)[0], 6.f);
-    EXPECT_FLOAT_EQ(ps.value(2)[0], 0.f);  // pos = neg = 1 after the clamp
+    EXPECT_FLOAT_EQ(ps.value(2)[0], 0.f);               // pos = neg = 1 after the clamp
     EXPECT_GT(ps.raw()[ps.slice(1).raw_offset], 99.f);  // sigmoid raw is unbounded
 }
 

@@ -60,9 +60,7 @@ RefinerConfig small() {
     return c;
 }
 
-std::string temp_path(const std::string& name) {
-    return test::write_temp_file(name, "");
-}
+std::string temp_path(const std::string& name) { return test::write_temp_file(name, ""); }
 
 }  // namespace
 
@@ -172,14 +170,16 @@ TEST(Refiner, LpipsThroughTheDecoderTrains) {
 // identify, so the full-view error must drop.
 TEST(Refiner, LossDecreasesOnATinyRenderedScene) {
     const int res = 16;
-    Scene scene = load_scene(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
-                             {{"camera.width", std::to_string(res)}, {"camera.height", std::to_string(res)}, {"integrator.max_depth", "3"}});
+    Scene scene = load_scene(
+        std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
+        {{"camera.width", std::to_string(res)}, {"camera.height", std::to_string(res)}, {"integrator.max_depth", "3"}});
     LatentModel fitted(scene, Parameterisation::Code, 1), truth(scene, Parameterisation::Code, 2);
     RenderOptions ro = RenderOptions::from_scene(scene);
     ro.width = ro.height = res;
     ro.spp = 16;
     ro.seed = 3;
-    const std::vector<float> latent = render_toned(fitted, ro, ToneCurve::Clip), target = render_toned(truth, ro, ToneCurve::Clip);
+    const std::vector<float> latent = render_toned(fitted, ro, ToneCurve::Clip),
+                             target = render_toned(truth, ro, ToneCurve::Clip);
     AovImages aov = render_aovs(scene, SceneSpectra<3>::from_description(scene), res, res, ro.spp, ro.seed);
     RefinerInput in{res, res, latent, aov.normal, aov.distance};
     RefinerConfig cfg = small();

@@ -20,9 +20,9 @@ std::string lpips_dir() {
     return shared.empty() ? std::string() : shared + "/models/lpips";
 }
 
-#define REQUIRE_LPIPS(dir)                                                                                       \
-    const std::string dir = lpips_dir();                                                                         \
-    if (dir.empty() || !std::ifstream(dir + "/lpips_squeeze_v0.1.safetensors"))                                  \
+#define REQUIRE_LPIPS(dir)                                                      \
+    const std::string dir = lpips_dir();                                        \
+    if (dir.empty() || !std::ifstream(dir + "/lpips_squeeze_v0.1.safetensors")) \
         GTEST_SKIP() << "LPIPS weights not found (../shared/models/lpips; set LATENTPT_SHARED)";
 
 const Lpips& net() {
@@ -34,7 +34,8 @@ std::vector<float> noise_image(int w, int h, uint32_t seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(0.f, 1.f);
     std::vector<float> v(size_t(w) * h * 3);
-    for (size_t i = 0; i < v.size(); ++i) v[i] = 0.5f + 0.4f * std::sin(0.07f * float(i % (w * 3)) + 0.05f * float(i / (w * 3))) * u(rng);
+    for (size_t i = 0; i < v.size(); ++i)
+        v[i] = 0.5f + 0.4f * std::sin(0.07f * float(i % (w * 3)) + 0.05f * float(i / (w * 3))) * u(rng);
     return v;
 }
 
@@ -49,7 +50,8 @@ TEST(Lpips, ExampleTripletMatchesReference) {
     const double d0 = net().distance(ref.data, p0.data, ref.width, ref.height);
     const double d1 = net().distance(ref.data, p1.data, ref.width, ref.height);
     std::cout.precision(7);
-    std::cout << "LPIPS-squeeze ex_ref/ex_p0 = " << d0 << " (reference 0.711048), ex_ref/ex_p1 = " << d1 << " (reference 0.147902)\n";
+    std::cout << "LPIPS-squeeze ex_ref/ex_p0 = " << d0 << " (reference 0.711048), ex_ref/ex_p1 = " << d1
+              << " (reference 0.147902)\n";
     EXPECT_NEAR(d0, 0.711, 0.002);
     EXPECT_NEAR(d1, 0.148, 0.002);
     // FACTS.md: a faithful port reproduces the PyTorch numbers to about 1e-5.
@@ -121,7 +123,9 @@ TEST(Lpips, TorchCoreHasFiniteNonZeroGradients) {
     const double analytic = (a64.grad() * v).sum().item<double>();
     const double eps = 1e-5;
     torch::NoGradGuard ng;
-    const double numeric = (lpips_torch(n, a64 + eps * v, b64).item<double>() - lpips_torch(n, a64 - eps * v, b64).item<double>()) / (2 * eps);
+    const double numeric =
+        (lpips_torch(n, a64 + eps * v, b64).item<double>() - lpips_torch(n, a64 - eps * v, b64).item<double>()) /
+        (2 * eps);
     EXPECT_NEAR(analytic, numeric, 1e-4 * std::max(1.0, std::abs(numeric)));
     // The plain API and the torch core agree.
     EXPECT_NEAR(lpips_torch(n, a.detach()[0].unsqueeze(0), b[0].unsqueeze(0)).item<double>(),

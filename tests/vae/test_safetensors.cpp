@@ -38,7 +38,8 @@ std::string parse_error(const std::string& bytes) {
 
 TEST(SafeTensors, ReadsAndConvertsEveryDtype) {
     float f32[2] = {1.5f, -2.25f};
-    std::string data = u16s({0x3f80, 0xc040}) + u16s({0x3c00, 0x0001, 0x7c00}) + std::string(reinterpret_cast<char*>(f32), 8);
+    std::string data =
+        u16s({0x3f80, 0xc040}) + u16s({0x3c00, 0x0001, 0x7c00}) + std::string(reinterpret_cast<char*>(f32), 8);
     std::string header = R"({"__metadata__": {"format": "pt"},
         "b": {"dtype": "BF16", "shape": [2], "data_offsets": [0, 4]},
         "h": {"dtype": "F16", "shape": [3, 1], "data_offsets": [4, 10]},
@@ -73,12 +74,17 @@ TEST(SafeTensors, MalformedFilesAreClearErrors) {
     expect(parse_error(file_bytes(ok_header, data).substr(0, 20)), "header length");
     expect(parse_error(file_bytes(ok_header, data.substr(0, 4))), "outside the 4-byte data section");
     expect(parse_error(file_bytes("{not json", data)), "malformed header");
-    expect(parse_error(file_bytes(R"({"w": {"dtype": "F32", "shape": [3], "data_offsets": [0, 8]}})", data)), "needs 12 bytes");
-    expect(parse_error(file_bytes(R"({"w": {"dtype": "I64", "shape": [1], "data_offsets": [0, 8]}})", data)), "unsupported dtype 'I64'");
+    expect(parse_error(file_bytes(R"({"w": {"dtype": "F32", "shape": [3], "data_offsets": [0, 8]}})", data)),
+           "needs 12 bytes");
+    expect(parse_error(file_bytes(R"({"w": {"dtype": "I64", "shape": [1], "data_offsets": [0, 8]}})", data)),
+           "unsupported dtype 'I64'");
     expect(parse_error(file_bytes(R"({"w": {"dtype": "F32", "shape": [2]}})", data)), "tensor 'w'");
     expect(parse_error(file_bytes(R"({"a": {"dtype": "F32", "shape": [2], "data_offsets": [0, 8]},
-                                      "b": {"dtype": "F32", "shape": [1], "data_offsets": [4, 8]}})", data)), "overlap");
-    expect(parse_error(file_bytes(R"({"w": {"dtype": "F32", "shape": [-2], "data_offsets": [0, 8]}})", data)), "non-negative");
+                                      "b": {"dtype": "F32", "shape": [1], "data_offsets": [4, 8]}})",
+                                  data)),
+           "overlap");
+    expect(parse_error(file_bytes(R"({"w": {"dtype": "F32", "shape": [-2], "data_offsets": [0, 8]}})", data)),
+           "non-negative");
     try {
         SafeTensors::load("/nonexistent/x.safetensors");
         FAIL();

@@ -21,7 +21,8 @@ std::vector<float> pattern(int w, int h, int c, uint32_t seed, float lo = 0.f, f
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             for (int k = 0; k < c; ++k) {
-                const float s = 0.5f + 0.35f * std::sin(0.3f * x + 0.7f * k) * std::cos(0.2f * y + float(seed)) + 0.15f * (u(rng) - 0.5f);
+                const float s = 0.5f + 0.35f * std::sin(0.3f * x + 0.7f * k) * std::cos(0.2f * y + float(seed)) +
+                                0.15f * (u(rng) - 0.5f);
                 v[(size_t(y) * w + x) * c + k] = lo + (hi - lo) * s;
             }
     return v;
@@ -33,7 +34,8 @@ std::vector<float> pattern(int w, int h, int c, uint32_t seed, float lo = 0.f, f
 double naive_ssim(const std::vector<float>& a, const std::vector<float>& b, int w, int h, int ch, double L) {
     double win[11][11], norm = 0;
     for (int i = 0; i < 11; ++i)
-        for (int j = 0; j < 11; ++j) norm += win[i][j] = std::exp(-((i - 5) * (i - 5) + (j - 5) * (j - 5)) / (2 * 1.5 * 1.5));
+        for (int j = 0; j < 11; ++j)
+            norm += win[i][j] = std::exp(-((i - 5) * (i - 5) + (j - 5) * (j - 5)) / (2 * 1.5 * 1.5));
     for (auto& row : win)
         for (double& v : row) v /= norm;
     const double C1 = (0.01 * L) * (0.01 * L), C2 = (0.03 * L) * (0.03 * L);
@@ -43,7 +45,9 @@ double naive_ssim(const std::vector<float>& a, const std::vector<float>& b, int 
         int count = 0;
         for (int y0 = 0; y0 + 11 <= h; ++y0)
             for (int x0 = 0; x0 + 11 <= w; ++x0) {
-                auto at = [&](const std::vector<float>& img, int i, int j) { return double(img[(size_t(y0 + i) * w + x0 + j) * ch + k]); };
+                auto at = [&](const std::vector<float>& img, int i, int j) {
+                    return double(img[(size_t(y0 + i) * w + x0 + j) * ch + k]);
+                };
                 double ma = 0, mb = 0;
                 for (int i = 0; i < 11; ++i)
                     for (int j = 0; j < 11; ++j) {
@@ -97,11 +101,17 @@ TEST(Ssim, ConstantImagesHaveTheClosedForm) {
 }
 
 TEST(Ssim, MatchesNaiveReferenceAndIsSymmetric) {
-    struct Case { int w, h, c; double L; float lo, hi; };
-    for (const Case& k : {Case{11, 11, 1, 1.0, 0.f, 1.f}, Case{19, 13, 3, 1.0, 0.f, 1.f}, Case{16, 16, 16, 6.0, -3.f, 3.f}}) {
+    struct Case {
+        int w, h, c;
+        double L;
+        float lo, hi;
+    };
+    for (const Case& k :
+         {Case{11, 11, 1, 1.0, 0.f, 1.f}, Case{19, 13, 3, 1.0, 0.f, 1.f}, Case{16, 16, 16, 6.0, -3.f, 3.f}}) {
         std::vector<float> a = pattern(k.w, k.h, k.c, 1, k.lo, k.hi), b = pattern(k.w, k.h, k.c, 2, k.lo, k.hi);
         const double ref = naive_ssim(a, b, k.w, k.h, k.c, k.L);
-        const double ab = ssim(a.data(), b.data(), k.w, k.h, k.c, k.L), ba = ssim(b.data(), a.data(), k.w, k.h, k.c, k.L);
+        const double ab = ssim(a.data(), b.data(), k.w, k.h, k.c, k.L),
+                     ba = ssim(b.data(), a.data(), k.w, k.h, k.c, k.L);
         EXPECT_NEAR(ab, ref, 1e-10) << k.w << "x" << k.h << "x" << k.c;
         EXPECT_NEAR(ab, ba, 1e-14);
         EXPECT_LT(ab, 0.999);

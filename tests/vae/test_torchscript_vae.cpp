@@ -33,15 +33,16 @@ const std::string& exported_dir() {
         const std::string shared = test::shared_dir(), py = python_with_torch();
         if (shared.empty() || py.empty()) return std::string();
         const fs::path out = test::temp_dir("torchscript-taesd3");
-        const std::string cmd = py + " " LPT_SOURCE_DIR "/tools/export_taesd3.py --weights " + shared + "/models/taesd3 --out " + out.string() + " >/dev/null";
+        const std::string cmd = py + " " LPT_SOURCE_DIR "/tools/export_taesd3.py --weights " + shared +
+                                "/models/taesd3 --out " + out.string() + " >/dev/null";
         if (std::system(cmd.c_str()) != 0) return std::string("FAILED");
         return out.string();
     }();
     return dir;
 }
 
-#define REQUIRE_EXPORT(dir)                                                                                  \
-    const std::string dir = exported_dir();                                                                  \
+#define REQUIRE_EXPORT(dir)                                                                                       \
+    const std::string dir = exported_dir();                                                                       \
     if (dir.empty()) GTEST_SKIP() << "needs python3-torch and ../shared/models/taesd3 (scripts/install-deps.sh)"; \
     ASSERT_NE(dir, "FAILED") << "tools/export_taesd3.py failed";
 
@@ -50,7 +51,8 @@ std::vector<float> test_image(int w, int h) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c)
-                v[(size_t(y) * w + x) * 3 + c] = 0.5f + 0.45f * std::sin(0.11f * float(x * (c + 1)) + 0.07f * float(y) + float(c));
+                v[(size_t(y) * w + x) * 3 + c] =
+                    0.5f + 0.45f * std::sin(0.11f * float(x * (c + 1)) + 0.07f * float(y) + float(c));
     return v;
 }
 
@@ -81,7 +83,8 @@ TEST(TorchScriptVae, RawLatentsAndSignedRangeAreMappedBack) {
     // 2x-1 and (z/scale + shift), and undo both, so the composition differs from the model-space
     // description by exactly those affine maps.
     const std::string cfg = dir + "/raw.json";
-    std::ofstream(cfg) << R"({"channels": 16, "downsample": 8, "scale": 2.0, "shift": 0.5, "image_range": [-1, 1], "latent": "raw"})";
+    std::ofstream(cfg)
+        << R"({"channels": 16, "downsample": 8, "scale": 2.0, "shift": 0.5, "image_range": [-1, 1], "latent": "raw"})";
     auto model = load_torchscript_vae(dir + "/encoder.pt", dir + "/decoder.pt", dir + "/vae.json");
     auto raw = load_torchscript_vae(dir + "/encoder.pt", dir + "/decoder.pt", cfg);
     const int w = 16, h = 16;
@@ -101,7 +104,8 @@ TEST(TorchScriptVae, RawLatentsAndSignedRangeAreMappedBack) {
 
 TEST(TorchScriptVae, BadFilesAndConfigsNameTheProblem) {
     const fs::path d = test::temp_dir("torchscript-bad");
-    auto expect_error = [](const std::string& enc, const std::string& dec, const std::string& cfg, const std::string& needle) {
+    auto expect_error = [](const std::string& enc, const std::string& dec, const std::string& cfg,
+                           const std::string& needle) {
         try {
             load_torchscript_vae(enc, dec, cfg);
             ADD_FAILURE() << "accepted; expected an error with '" << needle << "'";
@@ -114,9 +118,11 @@ TEST(TorchScriptVae, BadFilesAndConfigsNameTheProblem) {
     expect_error("e.pt", "d.pt", (d / "none.json").string(), "none.json");
     std::ofstream(cfg) << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1]})";
     expect_error("e.pt", "d.pt", cfg, "'latent'");
-    std::ofstream(cfg) << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1], "latent": "weird"})";
+    std::ofstream(cfg)
+        << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1], "latent": "weird"})";
     expect_error("e.pt", "d.pt", cfg, "latent");
-    std::ofstream(cfg) << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1], "latent": "raw"})";
+    std::ofstream(cfg)
+        << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1], "latent": "raw"})";
     expect_error((d / "missing.pt").string(), junk, cfg, "missing.pt");
     expect_error(junk, junk, cfg, "junk.pt");
     std::ofstream(cfg) << "{ broken";

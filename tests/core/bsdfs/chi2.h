@@ -76,13 +76,14 @@ struct Chi2Result {
 };
 
 inline Vec3f sphere_dir(double theta, double phi) {
-    return Vec3f(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)));
+    return Vec3f(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
+                 float(std::cos(theta)));
 }
 
 /// Pearson's chi-square of observed against expected cell counts (cells of expected < 5 pooled);
 /// cell n_cells holds the samples outside the density.
-inline Chi2Result chi2_from_counts(const std::vector<double>& observed, const std::vector<double>& expected, int n_cells, int n_samples,
-                                   double total, double significance) {
+inline Chi2Result chi2_from_counts(const std::vector<double>& observed, const std::vector<double>& expected,
+                                   int n_cells, int n_samples, double total, double significance) {
     Chi2Result r;
     std::ostringstream msg;
     msg << "integral of pdf = " << total << ", samples outside the density = " << observed[n_cells] << "/" << n_samples;
@@ -111,8 +112,8 @@ inline Chi2Result chi2_from_counts(const std::vector<double>& observed, const st
     r.dof -= 1;
     r.p_value = r.dof > 0 ? gamma_q(0.5 * r.dof, 0.5 * r.statistic) : 1.0;
     r.passed = r.p_value >= significance;
-    msg << "; chi2 = " << r.statistic << ", dof = " << r.dof << ", p = " << r.p_value
-        << " (needs >= " << significance << ")";
+    msg << "; chi2 = " << r.statistic << ", dof = " << r.dof << ", p = " << r.p_value << " (needs >= " << significance
+        << ")";
     r.summary = msg.str();
     return r;
 }
@@ -121,8 +122,8 @@ inline Chi2Result chi2_from_counts(const std::vector<double>& observed, const st
 /// pdf(w): solid-angle density of the tested part. Quadrature nodes lie strictly inside cells,
 /// so density jumps at the horizon (a cell edge) are harmless.
 template <class SampleFn, class PdfFn>
-Chi2Result chi2_sphere_test(SampleFn&& sample, PdfFn&& pdf, int n_samples, double significance,
-                            int n_theta = 10, int n_phi = 20, int min_sub = 4) {
+Chi2Result chi2_sphere_test(SampleFn&& sample, PdfFn&& pdf, int n_samples, double significance, int n_theta = 10,
+                            int n_phi = 20, int min_sub = 4) {
     const int n_cells = n_theta * n_phi;
     std::vector<double> observed(n_cells + 1, 0.0), expected(n_cells + 1, 0.0);
     const double d_theta = kPi / n_theta, d_phi = 2.0 * kPi / n_phi;
@@ -287,8 +288,8 @@ inline void expect_reciprocal(const Props& p, bool both_sides, float eta = 1.f, 
             nonzero += f1.abs().maxCoeff() > 0.f;
             float scale = std::max(f1.abs().maxCoeff(), g.abs().maxCoeff());
             if ((f1 - g).abs().maxCoeff() > 2e-3f * scale + 1e-6f && failures++ == 0)
-                first = std::to_string(f1[0]) + " vs " + std::to_string(g[0]) + " at wi.z = " +
-                        std::to_string(wi.z()) + ", wo.z = " + std::to_string(wo.z());
+                first = std::to_string(f1[0]) + " vs " + std::to_string(g[0]) + " at wi.z = " + std::to_string(wi.z()) +
+                        ", wo.z = " + std::to_string(wo.z());
         }
         EXPECT_EQ(failures, 0) << describe(p) << (mode == TransportMode::Radiance ? " radiance" : " importance")
                                << ", first: " << first;

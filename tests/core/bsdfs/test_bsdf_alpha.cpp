@@ -103,8 +103,10 @@ std::vector<Case> rough_cases(bool plastic_diffuse) {
             for (bool nonlinear : {false, true}) {
                 auto p = props("roughplastic", D);
                 p->values["nonlinear"] = nonlinear;
-                cases.push_back({"roughplastic diffuse " + D + (nonlinear ? " nonlinear" : ""), p,
-                                 {{"diffuse_reflectance", nonlinear ? ramp(-0.4f, 0.9f) : c1}, {"specular_reflectance", zero}}});
+                cases.push_back(
+                    {"roughplastic diffuse " + D + (nonlinear ? " nonlinear" : ""),
+                     p,
+                     {{"diffuse_reflectance", nonlinear ? ramp(-0.4f, 0.9f) : c1}, {"specular_reflectance", zero}}});
             }
             continue;
         }
@@ -117,7 +119,8 @@ std::vector<Case> rough_cases(bool plastic_diffuse) {
                              props("roughdielectric", D),
                              {{"specular_reflectance", c1}, {"specular_transmittance", c2}},
                              mode});
-        cases.push_back({"roughplastic specular " + D, props("roughplastic", D),
+        cases.push_back({"roughplastic specular " + D,
+                         props("roughplastic", D),
                          {{"specular_reflectance", c1}, {"diffuse_reflectance", zero}}});
     }
     return cases;
@@ -206,24 +209,31 @@ TEST(MicrofacetAlpha, DerivativesMatchCentralDifferences) {
                 if (d.D(m) > 1e-30f) {  // a normal float with digits to spare
                     double fd = (ref_D(type, a + h, m) - ref_D(type, a - h, m)) / (2.0 * h);
                     double g = d.dD_dalpha(m), floor = 1e-5 * ref_D(type, a, m) / a;
-                    EXPECT_LE(std::abs(g - fd), rel * std::abs(fd) + floor) << name(type) << " α " << alpha << " m " << m.transpose();
+                    EXPECT_LE(std::abs(g - fd), rel * std::abs(fd) + floor)
+                        << name(type) << " α " << alpha << " m " << m.transpose();
                     nD += std::abs(fd) > 1e-2 * ref_D(type, a, m) / a;
                 }
                 double fd = (ref_G1(type, a + h, p.v, m) - ref_G1(type, a - h, p.v, m)) / (2.0 * h);
                 double g = d.dG1_dalpha(p.v, m), floor = 1e-5 * ref_G1(type, a, p.v, m) / a;
-                EXPECT_LE(std::abs(g - fd), rel * std::abs(fd) + floor) << name(type) << " α " << alpha << " v " << p.v.transpose();
+                EXPECT_LE(std::abs(g - fd), rel * std::abs(fd) + floor)
+                    << name(type) << " α " << alpha << " v " << p.v.transpose();
                 nG += std::abs(fd) > 1e-2 * ref_G1(type, a, p.v, m) / a;
                 // G = G1 G1: the product rule of dG_dalpha.
                 Vec3f wo = sphere(0.5f + 0.5f * std::abs(p.v.x()), 0.5f + 0.5f * p.v.y());
                 double fdG = (ref_G1(type, a + h, p.v, m) * ref_G1(type, a + h, wo, m) -
-                              ref_G1(type, a - h, p.v, m) * ref_G1(type, a - h, wo, m)) / (2.0 * h);
+                              ref_G1(type, a - h, p.v, m) * ref_G1(type, a - h, wo, m)) /
+                             (2.0 * h);
                 double gG = d.dG_dalpha(p.v, wo, m);
-                EXPECT_LE(std::abs(gG - fdG), rel * std::abs(fdG) + 1e-5 * d.G(p.v, wo, m) / a) << name(type) << " α " << alpha;
+                EXPECT_LE(std::abs(gG - fdG), rel * std::abs(fdG) + 1e-5 * d.G(p.v, wo, m) / a)
+                    << name(type) << " α " << alpha;
                 // D G: the product rule of dDG_dalpha, the factor every rough plugin uses.
                 if (d.D(m) > 1e-30f) {
-                    auto DG = [&](double al) { return ref_D(type, al, m) * ref_G1(type, al, p.v, m) * ref_G1(type, al, wo, m); };
+                    auto DG = [&](double al) {
+                        return ref_D(type, al, m) * ref_G1(type, al, p.v, m) * ref_G1(type, al, wo, m);
+                    };
                     double fdDG = (DG(a + h) - DG(a - h)) / (2.0 * h), gDG = d.dDG_dalpha(p.v, wo, m);
-                    EXPECT_LE(std::abs(gDG - fdDG), rel * std::abs(fdDG) + 1e-5 * DG(a) / a) << name(type) << " α " << alpha;
+                    EXPECT_LE(std::abs(gDG - fdDG), rel * std::abs(fdDG) + 1e-5 * DG(a) / a)
+                        << name(type) << " α " << alpha;
                 }
             }
             EXPECT_GT(nD, 1000) << name(type) << " α " << alpha;  // non-trivial derivatives were compared
@@ -235,7 +245,7 @@ TEST(MicrofacetAlpha, FiniteAtDegenerateDirections) {
     // Grazing directions whose tan² overflows or whose cos⁴ underflows: values as D/G1, and
     // finite derivatives (no 0 · inf).
     const std::vector<Vec3f> dirs = {Vec3f(1.f, 0.f, 1e-30f), Vec3f(0.6f, 0.8f, 1e-21f), Vec3f(1.f, 0.f, 1e-12f),
-                                     Vec3f(0.f, 0.f, 1.f), Vec3f(0.f, 0.f, -1.f), Vec3f(1.f, 0.f, 0.f)};
+                                     Vec3f(0.f, 0.f, 1.f),    Vec3f(0.f, 0.f, -1.f),     Vec3f(1.f, 0.f, 0.f)};
     for (MicrofacetType type : kTypes)
         for (float alpha : {1e-4f, 0.3f, 3.f})
             for (const Vec3f& v : dirs)
@@ -271,10 +281,10 @@ TEST(BSDFAlpha, EvalGradMatchesCentralDifferences) {
     // diffuse lobe, whose t(μ) and ∂t/∂α tables are an interpolant and its exact derivative,
     // docs/bsdfs.md (46); twosided from both faces). eval is float, so its differences need a
     // larger step than (37)-(39)'s h = 1e-4 α: h = 2e-3 α with Richardson extrapolation.
-    // Truncation ~h⁴ f⁽⁵⁾/30 < 2e-4 relative down to 70 e-folds of a Beckmann tail; rounding ~10 eps |f| / (2h) per difference,
-    // ~3e-4 |f|/α after extrapolation. Hence the tolerance 1e-3 (|fd| + |f|/α): relative 1e-3 of
-    // the derivative, floored at 1e-3 of the natural scale |f|/α where ∂f/∂α changes sign, and
-    // at 1e-30 absolute: far tails where D or f is (nearly) subnormal carry no digits.
+    // Truncation ~h⁴ f⁽⁵⁾/30 < 2e-4 relative down to 70 e-folds of a Beckmann tail; rounding ~10 eps |f| / (2h) per
+    // difference, ~3e-4 |f|/α after extrapolation. Hence the tolerance 1e-3 (|fd| + |f|/α): relative 1e-3 of the
+    // derivative, floored at 1e-3 of the natural scale |f|/α where ∂f/∂α changes sign, and at 1e-30 absolute: far tails
+    // where D or f is (nearly) subnormal carry no digits.
     const float rel = 1e-3f, tiny = 1e-30f;
     std::vector<Case> cases = rough_cases(false), diffuse = rough_cases(true);
     cases.insert(cases.end(), diffuse.begin(), diffuse.end());
@@ -291,12 +301,14 @@ TEST(BSDFAlpha, EvalGradMatchesCentralDifferences) {
                 for (int c = 0; c < 16; ++c) {
                     float g = r.grad[i][c], fd = r.fd[i][c], f = r.value[i][c];
                     float tol = rel * (std::abs(fd) + std::abs(f) / alpha) + tiny;
-                    EXPECT_LE(std::abs(g - fd), tol) << cs.name << " α " << alpha << " channel " << c << " wi "
-                                                     << pairs[i].first.transpose() << " wo " << pairs[i].second.transpose();
+                    EXPECT_LE(std::abs(g - fd), tol)
+                        << cs.name << " α " << alpha << " channel " << c << " wi " << pairs[i].first.transpose()
+                        << " wo " << pairs[i].second.transpose();
                     nonzero += std::abs(fd) > 1e-2f * std::abs(f) / alpha && std::abs(fd) > 1e-20f;
                 }
                 EXPECT_TRUE(r.grad[i].isFinite().all()) << cs.name;
-                if (pairs[i].first.z() < 0.f && cs.name.rfind("rough", 0) == 0 && cs.name.find("dielectric") == std::string::npos) {
+                if (pairs[i].first.z() < 0.f && cs.name.rfind("rough", 0) == 0 &&
+                    cs.name.find("dielectric") == std::string::npos) {
                     EXPECT_TRUE((r.grad[i] == 0.f).all()) << cs.name << ": one-sided";
                 }
             }
@@ -318,7 +330,8 @@ TEST(BSDFAlpha, RoughPlasticGradientIsTheSumOfItsLobes) {
             diff->set_spectral("diffuse_reflectance", rd), diff->set_spectral("specular_reflectance", zero);
             for (const auto& [wi, wo] : direction_pairs(*full, 41, 256)) {
                 Spectrum<16> g = full->eval_grad_scalar(BSDFContext{}, wi, wo, 0);
-                Spectrum<16> sum = spec->eval_grad_scalar(BSDFContext{}, wi, wo, 0) + diff->eval_grad_scalar(BSDFContext{}, wi, wo, 0);
+                Spectrum<16> sum =
+                    spec->eval_grad_scalar(BSDFContext{}, wi, wo, 0) + diff->eval_grad_scalar(BSDFContext{}, wi, wo, 0);
                 EXPECT_LE((g - sum).abs().maxCoeff(), 1e-6f * (1.f + g.abs().maxCoeff())) << d;
             }
         }
@@ -331,9 +344,11 @@ TEST(BSDFAlpha, WeightGradIsEvalGradOverPdf) {
     std::vector<Case> cases = rough_cases(false);
     const Spectrum<16> c1 = ramp(-0.4f, 1.3f), c2 = ramp(0.9f, -0.6f);
     for (const char* d : {"beckmann", "ggx"}) {
-        cases.push_back({std::string("roughplastic ") + d, props("roughplastic", d),
+        cases.push_back({std::string("roughplastic ") + d,
+                         props("roughplastic", d),
                          {{"diffuse_reflectance", c1}, {"specular_reflectance", c2}}});
-        cases.push_back({std::string("twosided roughplastic ") + d, twosided(props("roughplastic", d)),
+        cases.push_back({std::string("twosided roughplastic ") + d,
+                         twosided(props("roughplastic", d)),
                          {{"diffuse_reflectance", c1}, {"specular_reflectance", c2}}});
     }
     for (const Case& cs : cases)
@@ -347,7 +362,8 @@ TEST(BSDFAlpha, WeightGradIsEvalGradOverPdf) {
                 float z = (i % 2 ? 1.f : -1.f) * (0.05f + 0.95f * sample_1d(51, i, 0, 0));
                 float r = std::sqrt(1.f - z * z), phi = 2.f * kPi * sample_1d(51, i, 0, 1);
                 Vec3f wi(r * std::cos(phi), r * std::sin(phi), z);
-                BSDFSample<16> bs = bsdf->sample(ctx, wi, sample_1d(51, i, 0, 2), Vec2f(sample_1d(51, i, 0, 3), sample_1d(51, i, 0, 4)));
+                BSDFSample<16> bs = bsdf->sample(ctx, wi, sample_1d(51, i, 0, 2),
+                                                 Vec2f(sample_1d(51, i, 0, 3), sample_1d(51, i, 0, 4)));
                 if (!bs.valid()) continue;
                 ASSERT_FALSE(bs.lobe & kDelta) << cs.name;
                 ++n_valid;
@@ -391,15 +407,19 @@ TEST(BSDFAlpha, SetScalarEqualsFreshConstruction) {
                     BSDFContext ctx;
                     EXPECT_TRUE((a.eval(ctx, wi, wo) == b.eval(ctx, wi, wo)).all()) << type << " " << d << " " << what;
                     EXPECT_EQ(a.pdf(ctx, wi, wo), b.pdf(ctx, wi, wo)) << type << " " << d << " " << what;
-                    EXPECT_TRUE((a.eval_grad_scalar(ctx, wi, wo, 0) == b.eval_grad_scalar(ctx, wi, wo, 0)).all()) << type << " " << d << " " << what;
+                    EXPECT_TRUE((a.eval_grad_scalar(ctx, wi, wo, 0) == b.eval_grad_scalar(ctx, wi, wo, 0)).all())
+                        << type << " " << d << " " << what;
                     for (int k = 0; k < nkeys; ++k)
-                        EXPECT_TRUE((a.eval_grad(ctx, wi, wo, k) == b.eval_grad(ctx, wi, wo, k)).all()) << type << " " << d << " " << what;
+                        EXPECT_TRUE((a.eval_grad(ctx, wi, wo, k) == b.eval_grad(ctx, wi, wo, k)).all())
+                            << type << " " << d << " " << what;
                     BSDFSample<16> sa = a.sample(ctx, wi, u1, u2), sb = b.sample(ctx, wi, u1, u2);
                     EXPECT_EQ(sa.pdf, sb.pdf) << type << " " << d << " " << what;
                     EXPECT_EQ(sa.wo, sb.wo) << type << " " << d << " " << what;
                     EXPECT_TRUE((sa.weight == sb.weight).all()) << type << " " << d << " " << what;
                     if (sa.valid()) {
-                        EXPECT_TRUE((a.weight_grad_scalar(ctx, wi, sa, 0) == b.weight_grad_scalar(ctx, wi, sb, 0)).all()) << type << " " << d;
+                        EXPECT_TRUE(
+                            (a.weight_grad_scalar(ctx, wi, sa, 0) == b.weight_grad_scalar(ctx, wi, sb, 0)).all())
+                            << type << " " << d;
                     }
                 }
             };
@@ -432,7 +452,9 @@ TEST(BSDFAlpha, KeysRoundTripClampAndErrors) {
             EXPECT_EQ(bsdf->get_scalar("alpha"), 0.4f) << type << ": a rejected value changes nothing";
             EXPECT_THROW(bsdf->get_scalar("roughness"), std::invalid_argument) << type;
             EXPECT_THROW(bsdf->set_scalar("alpha_u", 0.3f), std::invalid_argument) << type;
-            EXPECT_THROW(bsdf->eval_grad_scalar(BSDFContext{}, Vec3f(0, 0, 1), Vec3f(0, 0, 1), 1), std::invalid_argument) << type;
+            EXPECT_THROW(bsdf->eval_grad_scalar(BSDFContext{}, Vec3f(0, 0, 1), Vec3f(0, 0, 1), 1),
+                         std::invalid_argument)
+                << type;
             EXPECT_EQ(bsdf->get_scalar("alpha"), 0.4f) << type;
             // The constructor's clamp is the same.
             auto tiny = t == "twosided" ? twosided(props("roughplastic", d, 1e-6f)) : props(t, d, 1e-6f);
@@ -464,10 +486,13 @@ TEST(BSDFAlpha, GradientsFiniteOverTheWholeRange) {
                     Vec3f mirror(-wi.x(), -wi.y(), wi.z());
                     for (const Vec3f& wo : {mirror, Vec3f((mirror + Vec3f(1e-3f, 0.f, 0.f)).normalized()), Vec3f(-wi),
                                             sphere(sample_1d(71, i, 0, 2), sample_1d(71, i, 0, 3))})
-                        EXPECT_TRUE(bsdf->eval_grad_scalar(BSDFContext{}, wi, wo, 0).isFinite().all()) << type << " " << d << " " << alpha;
-                    BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, sample_1d(71, i, 0, 4), Vec2f(sample_1d(71, i, 0, 5), sample_1d(71, i, 0, 6)));
+                        EXPECT_TRUE(bsdf->eval_grad_scalar(BSDFContext{}, wi, wo, 0).isFinite().all())
+                            << type << " " << d << " " << alpha;
+                    BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, sample_1d(71, i, 0, 4),
+                                                     Vec2f(sample_1d(71, i, 0, 5), sample_1d(71, i, 0, 6)));
                     if (bs.valid()) {
-                        EXPECT_TRUE(bsdf->weight_grad_scalar(BSDFContext{}, wi, bs, 0).isFinite().all()) << type << " " << d << " " << alpha;
+                        EXPECT_TRUE(bsdf->weight_grad_scalar(BSDFContext{}, wi, bs, 0).isFinite().all())
+                            << type << " " << d << " " << alpha;
                     }
                 }
             }

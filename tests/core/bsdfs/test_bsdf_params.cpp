@@ -42,7 +42,8 @@ Spectrum<16> ramp(float a, float b) {
 }  // namespace
 
 TEST(BSDFParams, EveryCoefficientEntersAffinely) {
-    for (const char* type : {"diffuse", "conductor", "roughconductor", "dielectric", "roughdielectric", "plastic", "roughplastic", "twosided"}) {
+    for (const char* type : {"diffuse", "conductor", "roughconductor", "dielectric", "roughdielectric", "plastic",
+                             "roughplastic", "twosided"}) {
         std::shared_ptr<Props> p = props(type);
         if (std::string(type) == "twosided") p->values["bsdf"] = props("roughplastic");
         auto bsdf = make_bsdf<16>(*p);
@@ -51,14 +52,17 @@ TEST(BSDFParams, EveryCoefficientEntersAffinely) {
         const Spectrum<16> a = ramp(-0.4f, 0.9f), b = ramp(0.3f, -0.7f), zero = Spectrum<16>::Zero();
         for (const std::string& key : keys) {
             for (uint32_t i = 0; i < 64; ++i) {
-                Vec3f wi = Vec3f(sample_1d(1, i, 0, 0) - 0.5f, sample_1d(1, i, 0, 1) - 0.5f, 0.2f + sample_1d(1, i, 0, 2)).normalized();
+                Vec3f wi =
+                    Vec3f(sample_1d(1, i, 0, 0) - 0.5f, sample_1d(1, i, 0, 1) - 0.5f, 0.2f + sample_1d(1, i, 0, 2))
+                        .normalized();
                 float u1 = sample_1d(1, i, 0, 3);
                 Vec2f u2(sample_1d(1, i, 0, 4), sample_1d(1, i, 0, 5));
                 auto run = [&](const Spectrum<16>& v, Vec3f* wo_out) {
                     bsdf->set_spectral(key, v);
                     BSDFSample<16> bs = bsdf->sample(BSDFContext{}, wi, u1, u2);
                     if (wo_out) *wo_out = bs.wo;
-                    return std::pair{bs, bs.valid() ? bsdf->eval(BSDFContext{}, wi, bs.wo) : Spectrum<16>::Zero().eval()};
+                    return std::pair{bs,
+                                     bs.valid() ? bsdf->eval(BSDFContext{}, wi, bs.wo) : Spectrum<16>::Zero().eval()};
                 };
                 Vec3f wo;
                 auto [s_ab, e_ab] = run(a + b, &wo);
@@ -82,8 +86,9 @@ TEST(BSDFParams, EveryCoefficientEntersAffinely) {
 
 /// eval_grad (at random wo and at sampled wo) and weight_grad of coefficient `key` against central
 /// differences between coefficient values cp and cm (`step` = cp - cm), at 64 directions.
-static void expect_gradients_match(BSDF<16>& b, const std::string& name, int key, const std::string& key_name, const Spectrum<16>& c,
-                            const Spectrum<16>& step, const Spectrum<16>& cp, const Spectrum<16>& cm, float tol) {
+static void expect_gradients_match(BSDF<16>& b, const std::string& name, int key, const std::string& key_name,
+                                   const Spectrum<16>& c, const Spectrum<16>& step, const Spectrum<16>& cp,
+                                   const Spectrum<16>& cm, float tol) {
     BSDF<16>* bsdf = &b;
     int n_valid = 0;
     for (uint32_t i = 0; i < 64; ++i) {
@@ -118,7 +123,8 @@ static void expect_gradients_match(BSDF<16>& b, const std::string& name, int key
         Spectrum<16> em = bsdf->eval(BSDFContext{}, wi, bs.wo);
         ASSERT_TRUE(bp.valid() && bm.valid() && bp.lobe == bs.lobe && bm.lobe == bs.lobe) << name;
         Spectrum<16> fd_eval = (ep - em) / step, fd_weight = (bp.weight - bm.weight) / step;
-        EXPECT_LT((g_eval - fd_eval).abs().maxCoeff(), tol * (1.f + fd_eval.abs().maxCoeff())) << name << " " << key_name;
+        EXPECT_LT((g_eval - fd_eval).abs().maxCoeff(), tol * (1.f + fd_eval.abs().maxCoeff()))
+            << name << " " << key_name;
         EXPECT_LT((g_weight - fd_weight).abs().maxCoeff(), tol * (1.f + fd_weight.abs().maxCoeff()))
             << name << " " << key_name << " lobe " << bs.lobe;
     }
@@ -152,7 +158,8 @@ TEST(BSDFParams, CoefficientGradientsMatchFiniteDifferences) {
         {"twosided diffuse", twosided(props("diffuse"))},
         {"roughconductor", props("roughconductor")},
         {"roughconductor eta/k", with(with(props("roughconductor"), "eta", eta), "k", k)},
-        {"roughconductor ggx eta/k", with(with(with(props("roughconductor"), "eta", eta), "k", k), "distribution", ggx)},
+        {"roughconductor ggx eta/k",
+         with(with(with(props("roughconductor"), "eta", eta), "k", k), "distribution", ggx)},
         {"roughdielectric", props("roughdielectric")},
         {"roughdielectric ggx", with(props("roughdielectric"), "distribution", ggx)},
         {"plastic", props("plastic")},

@@ -70,8 +70,9 @@ TEST(Fresnel, ConductorLimits) {
 
 TEST(Fresnel, DiffuseReflectanceKnownValueAndIdentity) {
     EXPECT_NEAR(fresnel_diffuse_reflectance(1.5f), 0.0918f, 5e-4f);  // d'Eon & Irving's fit: 0.09179
-    for (float eta : {1.33f, 1.5f, 2.f})  // 1 - Fdr(1/eta) = (1 - Fdr(eta)) / eta^2
-        EXPECT_NEAR(1.f - fresnel_diffuse_reflectance(1.f / eta), (1.f - fresnel_diffuse_reflectance(eta)) / (eta * eta), 1e-5f);
+    for (float eta : {1.33f, 1.5f, 2.f})                             // 1 - Fdr(1/eta) = (1 - Fdr(eta)) / eta^2
+        EXPECT_NEAR(1.f - fresnel_diffuse_reflectance(1.f / eta),
+                    (1.f - fresnel_diffuse_reflectance(eta)) / (eta * eta), 1e-5f);
 }
 
 TEST(Microfacet, DistributionAndVisibleNormalsNormalised) {
@@ -80,7 +81,7 @@ TEST(Microfacet, DistributionAndVisibleNormalsNormalised) {
             MicrofacetDistribution d(t, alpha);
             for (float cos_i : {1.f, 0.6f, 0.2f}) {
                 Vec3f wi = dir(cos_i, 0.7f);
-                double proj = 0.0, vis = 0.0;  // ∫ D cos dm = 1, ∫ G1 <wi,m> D dm = cos wi
+                double proj = 0.0, vis = 0.0;   // ∫ D cos dm = 1, ∫ G1 <wi,m> D dm = cos wi
                 const int nt = 2000, np = 128;  // theta grid refined where the lobe is
                 for (int a = 0; a < nt; ++a) {
                     double u = (a + 0.5) / nt, theta = 0.5 * kPi * u * u, dtheta = kPi * u / nt;
@@ -223,11 +224,13 @@ TEST(Dielectric, ReflectPlusTransmitIsOneInImportanceMode) {
 }
 
 TEST(RoughDielectric, SampleMatchesPdfChi2) {
-    for (const Props& p : rough_sets("roughdielectric", {{"int_ior", 1.5f}, {"ext_ior", 1.f}})) expect_chi2(p, kBothSides);
+    for (const Props& p : rough_sets("roughdielectric", {{"int_ior", 1.5f}, {"ext_ior", 1.f}}))
+        expect_chi2(p, kBothSides);
 }
 TEST(RoughDielectric, WeightMatchesEvalOverPdf) {
     for (const Props& p : rough_sets("roughdielectric"))
-        for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance}) expect_weights(p, kBothSides, mode);
+        for (TransportMode mode : {TransportMode::Radiance, TransportMode::Importance})
+            expect_weights(p, kBothSides, mode);
 }
 TEST(RoughDielectric, Reciprocity) {
     for (const Props& p : rough_sets("roughdielectric", {{"int_ior", 1.5f}, {"ext_ior", 1.f}}))
@@ -265,7 +268,8 @@ TEST(RoughPlastic, SampleMatchesPdfChi2) {
     for (const Props& p : rough_sets("roughplastic")) expect_chi2(p, kUpper);
 }
 TEST(RoughPlastic, WeightMatchesEvalOverPdf) {
-    for (const Props& p : rough_sets("roughplastic", {{"nonlinear", true}})) expect_weights(p, kUpper, TransportMode::Radiance);
+    for (const Props& p : rough_sets("roughplastic", {{"nonlinear", true}}))
+        expect_weights(p, kUpper, TransportMode::Radiance);
 }
 TEST(RoughPlastic, Reciprocity) {
     for (const Props& p : rough_sets("roughplastic", {{"diffuse_reflectance", rgb(0.9f, 0.1f, 0.4f)}}))
@@ -276,7 +280,8 @@ TEST(RoughPlastic, Reciprocity) {
 /// the dense side. R is estimated here from the roughdielectric plugin's own sampling (reflected
 /// samples only), independently of roughplastic's tables; returns the estimate and its 1σ.
 std::pair<double, double> mitsuba_internal_reflectance(const std::string& distribution, float alpha, float eta) {
-    auto inside = make_bsdf<3>(props("roughdielectric", {{"distribution", distribution}, {"alpha", alpha}, {"int_ior", 1.f}, {"ext_ior", eta}}));
+    auto inside = make_bsdf<3>(props(
+        "roughdielectric", {{"distribution", distribution}, {"alpha", alpha}, {"int_ior", 1.f}, {"ext_ior", eta}}));
     const int n = 20000;
     double f = 0, var = 0;
     for (int j = 0; j < kTransmittanceRes; ++j) {
@@ -300,22 +305,26 @@ std::pair<double, double> mitsuba_internal_reflectance(const std::string& distri
 
 TEST(RoughPlastic, WhiteAlbedoFollowsMitsubasInternalReflectance) {
     // White, nonlinear = false: albedo(μ) = A(μ) + t(μ) T̄ / (η² (1 − F_int)), A the specular
-    // albedo, t the coating's transmittance (docs/bsdfs.md (25)-(27)). Mitsuba's F_int (a 64-point mean, ~1.5 % below the integral, and
-    // the rough interface's own) is not the smooth identity 1 − T̄/η², which would make the white
+    // albedo, t the coating's transmittance (docs/bsdfs.md (25)-(27)). Mitsuba's F_int (a 64-point mean, ~1.5 % below
+    // the integral, and the rough interface's own) is not the smooth identity 1 − T̄/η², which would make the white
     // plastic conserve energy exactly: the test tells the two apart by 1-5 % of the albedo.
     const float eta = 1.5f;
-    for (const Props& p : rough_sets("roughplastic", {{"diffuse_reflectance", 1.f}, {"int_ior", eta}, {"ext_ior", 1.f}})) {
+    for (const Props& p :
+         rough_sets("roughplastic", {{"diffuse_reflectance", 1.f}, {"int_ior", eta}, {"ext_ior", 1.f}})) {
         const std::string distribution = std::get<std::string>(p.values.at("distribution"));
         const float alpha = std::get<float>(p.values.at("alpha"));
         const auto [f_int, f_sigma] = mitsuba_internal_reflectance(distribution, alpha, eta);
         const MicrofacetType type = distribution == "ggx" ? MicrofacetType::GGX : MicrofacetType::Beckmann;
-        const TransmittanceTable table = rough_transmittance(type, eta, alpha), specular = rough_reflectance(type, eta, alpha);
+        const TransmittanceTable table = rough_transmittance(type, eta, alpha),
+                                 specular = rough_reflectance(type, eta, alpha);
         const double base = table.mean / (double(eta) * eta * (1.0 - f_int));
         for (const Vec3f& wi : kUpper) {
-            const double t_i = interpolate_mu(table.t, wi.z()), expected = interpolate_mu(specular.t, wi.z()) + t_i * base;
+            const double t_i = interpolate_mu(table.t, wi.z()),
+                         expected = interpolate_mu(specular.t, wi.z()) + t_i * base;
             const double expected_sigma = t_i * base / (1.0 - f_int) * f_sigma;
             Albedo a = albedo(*make_bsdf<3>(p), wi, TransportMode::Radiance);
-            EXPECT_NEAR(a.mean, expected, 3.0 * std::hypot(a.se, expected_sigma) + 2e-3) << describe(p) << ", cos wi " << wi.z();
+            EXPECT_NEAR(a.mean, expected, 3.0 * std::hypot(a.se, expected_sigma) + 2e-3)
+                << describe(p) << ", cos wi " << wi.z();
             EXPECT_LE(a.mean, 1.0 + 3.0 * a.se + 1e-5) << "passive: " << describe(p);
         }
     }
@@ -333,7 +342,8 @@ TEST(TwoSided, BackFaceMirrorsFrontFace) {
         auto flip = [](Vec3f w) { return Vec3f(w.x(), w.y(), -w.z()); };
         EXPECT_EQ((two->eval({}, flip(wi), flip(wo)) - one->eval({}, wi, wo)).abs().maxCoeff(), 0.f);
         EXPECT_EQ(two->pdf({}, flip(wi), flip(wo)), one->pdf({}, wi, wo));
-        BSDFSample<3> a = one->sample({}, wi, 0.4f, Vec2f(0.2f, 0.7f)), b = two->sample({}, flip(wi), 0.4f, Vec2f(0.2f, 0.7f));
+        BSDFSample<3> a = one->sample({}, wi, 0.4f, Vec2f(0.2f, 0.7f)),
+                      b = two->sample({}, flip(wi), 0.4f, Vec2f(0.2f, 0.7f));
         EXPECT_EQ(b.wo, flip(a.wo));
         EXPECT_EQ(two->eval({}, wi, wo)[0], one->eval({}, wi, wo)[0]);  // front face unchanged
     }
@@ -347,9 +357,10 @@ TEST(TwoSided, SampleMatchesPdfChi2FromBelow) {
 }
 
 TEST(TwoSided, EnergyBoundedOnBothFaces) {
-    for (const Props& inner : {props("diffuse", {{"reflectance", 1.f}}), props("plastic", {{"diffuse_reflectance", 1.f}}),
-                               rough_sets("roughconductor")[1]})
-        expect_energy(twosided(inner), {dir(0.7f, 1.f), dir(-0.7f, 1.f), dir(-0.2f, 2.f)}, TransportMode::Radiance, 0.8);
+    for (const Props& inner : {props("diffuse", {{"reflectance", 1.f}}),
+                               props("plastic", {{"diffuse_reflectance", 1.f}}), rough_sets("roughconductor")[1]})
+        expect_energy(twosided(inner), {dir(0.7f, 1.f), dir(-0.7f, 1.f), dir(-0.2f, 2.f)}, TransportMode::Radiance,
+                      0.8);
 }
 
 // (e) registry errors name the offending field.
@@ -375,22 +386,27 @@ TEST(BSDFRegistry, UnknownTypeAndBadValuesNameTheField) {
     Props nested = props("roughdielectric", {{"alpha", 0.f}});
     nested.where = "materials.glass";
     expect_scene_error(nested, "materials.glass.alpha", "alpha");
-    EXPECT_NEAR(make_bsdf<3>(props("dielectric", {{"int_ior", std::string("water")}}))->sample({}, dir(1.f, 0.f), 0.f, Vec2f(0.f, 0.f)).pdf,
+    EXPECT_NEAR(make_bsdf<3>(props("dielectric", {{"int_ior", std::string("water")}}))
+                    ->sample({}, dir(1.f, 0.f), 0.f, Vec2f(0.f, 0.f))
+                    .pdf,
                 fresnel_dielectric(1.f, 1.333f / 1.000277f).R, 1e-6f);
 }
 
 // (f) sampling depends on geometry only; 16 channels carry the luminance-broadcast values.
 std::vector<Props> all_types(const Values& colours) {
     std::vector<Props> out;
-    for (const char* t : {"diffuse", "conductor", "roughconductor", "dielectric", "roughdielectric", "plastic", "roughplastic"})
+    for (const char* t :
+         {"diffuse", "conductor", "roughconductor", "dielectric", "roughdielectric", "plastic", "roughplastic"})
         out.push_back(props(t, colours));
     out.push_back(twosided(props("roughplastic", colours)));
     return out;
 }
 TEST(BSDFSampling, IndependentOfSignedSpectralCoefficients) {
     Values a = {{"reflectance", rgb(0.5f, 0.5f, 0.5f)}, {"diffuse_reflectance", rgb(0.5f, 0.5f, 0.5f)}},
-           b = {{"reflectance", rgb(-0.7f, 0.f, 3.f)}, {"diffuse_reflectance", rgb(-0.7f, 0.f, 3.f)},
-                {"specular_reflectance", rgb(-1.f, 0.f, 0.2f)}, {"specular_transmittance", rgb(0.f, -2.f, 1.f)}};
+           b = {{"reflectance", rgb(-0.7f, 0.f, 3.f)},
+                {"diffuse_reflectance", rgb(-0.7f, 0.f, 3.f)},
+                {"specular_reflectance", rgb(-1.f, 0.f, 0.2f)},
+                {"specular_transmittance", rgb(0.f, -2.f, 1.f)}};
     std::vector<Props> pa = all_types(a), pb = all_types(b);
     for (size_t i = 0; i < pa.size(); ++i) {
         auto x = make_bsdf<3>(pa[i]);
@@ -434,7 +450,8 @@ TEST(Lambertian, ReflectanceIsWhatSampleWeightsWith) {
             const Vec3f wi = Vec3f(0.3f, -0.2f, wz).normalized();
             const Vec2f u(0.37f, 0.81f);
             const BSDFSample<3> own = bsdf->sample(ctx, wi, 0.5f, u);
-            const BSDFSample<3> tracer = lambertian_sample<3>(bsdf->lambertian(), wi, sample_cosine_hemisphere(u), bsdf->lambertian_reflectance(ctx));
+            const BSDFSample<3> tracer = lambertian_sample<3>(bsdf->lambertian(), wi, sample_cosine_hemisphere(u),
+                                                              bsdf->lambertian_reflectance(ctx));
             EXPECT_EQ(own.valid(), tracer.valid()) << p.type;
             if (!own.valid()) continue;
             EXPECT_TRUE((own.weight == tracer.weight).all()) << p.type;

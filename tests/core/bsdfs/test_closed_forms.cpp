@@ -74,15 +74,18 @@ TEST(ClosedForm, RoughConductorFurnaceConvergesToSmoothFresnel) {
                 const double smooth = fresnel_conductor<3>(cos_i, Spectrum<3>(eta), Spectrum<3>(k)).mean();
                 double previous = 1e9;
                 for (float alpha : {0.1f, 0.01f, 0.001f}) {
-                    auto bsdf = make_bsdf<3>(props("roughconductor", {{"distribution", std::string(distr)}, {"alpha", alpha},
-                                                                       {"eta", Eigen::Array3f(eta)}, {"k", Eigen::Array3f(k)}}));
+                    auto bsdf = make_bsdf<3>(props("roughconductor", {{"distribution", std::string(distr)},
+                                                                      {"alpha", alpha},
+                                                                      {"eta", Eigen::Array3f(eta)},
+                                                                      {"k", Eigen::Array3f(k)}}));
                     const double gap = std::abs(albedo_split(*bsdf, wi, TransportMode::Radiance).reflect - smooth);
                     if (alpha < 0.05f) {
                         EXPECT_LE(gap, previous + 1e-4) << distr << " alpha " << alpha << " cos " << cos_i;
                     }
                     previous = gap;
                 }
-                EXPECT_LT(previous, 2e-3) << distr << " eta " << eta.transpose() << " cos " << cos_i << ": alpha 0.001 albedo off by " << previous;
+                EXPECT_LT(previous, 2e-3) << distr << " eta " << eta.transpose() << " cos " << cos_i
+                                          << ": alpha 0.001 albedo off by " << previous;
             }
 }
 
@@ -94,8 +97,9 @@ TEST(ClosedForm, RoughDielectricFurnaceConvergesToSmoothInterface) {
         for (float cos_i : {0.9f, 0.5f, -0.9f, -0.5f}) {
             const Vec3f wi = dir(cos_i, 1.1f);
             const double R = fresnel_dielectric(cos_i, eta).R;
-            auto bsdf = make_bsdf<3>(props("roughdielectric", {{"distribution", std::string(distr)}, {"alpha", 0.001f},
-                                                                {"int_ior", eta}, {"ext_ior", 1.f}}));
+            auto bsdf = make_bsdf<3>(
+                props("roughdielectric",
+                      {{"distribution", std::string(distr)}, {"alpha", 0.001f}, {"int_ior", eta}, {"ext_ior", 1.f}}));
             const Split s = albedo_split(*bsdf, wi, TransportMode::Importance);
             EXPECT_NEAR(s.reflect + s.transmit, 1.0, 2e-3) << distr << " cos " << cos_i;
             EXPECT_NEAR(s.reflect, R, 3e-3) << distr << " cos " << cos_i;

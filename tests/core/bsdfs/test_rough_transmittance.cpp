@@ -29,17 +29,18 @@ TEST(RoughTransmittance, NodesReproduceTheDirectQuadrature) {
     // At a node the spline passes through the node's own quadrature with its slope.
     for (MicrofacetType type : kTypes)
         for (CoatingLobe lobe : {CoatingLobe::Transmission, CoatingLobe::Reflection})
-        for (int k : {40, 55, 64, 72}) {
-            float alpha = node_alpha(k);
-            TransmittanceTable c = rough_lobe_table(type, 1.49f, alpha, lobe), d = rough_lobe_table_direct(type, 1.49f, alpha, lobe);
-            const float dscale = max_abs(d.dt);
-            for (int j = 0; j < kTransmittanceRes; ++j) {
-                EXPECT_NEAR(c.t[j], d.t[j], 1e-6f) << name(type) << " α " << alpha << " j " << j;
-                EXPECT_NEAR(c.dt[j], d.dt[j], 1e-5f * dscale) << name(type) << " α " << alpha << " j " << j;
+            for (int k : {40, 55, 64, 72}) {
+                float alpha = node_alpha(k);
+                TransmittanceTable c = rough_lobe_table(type, 1.49f, alpha, lobe),
+                                   d = rough_lobe_table_direct(type, 1.49f, alpha, lobe);
+                const float dscale = max_abs(d.dt);
+                for (int j = 0; j < kTransmittanceRes; ++j) {
+                    EXPECT_NEAR(c.t[j], d.t[j], 1e-6f) << name(type) << " α " << alpha << " j " << j;
+                    EXPECT_NEAR(c.dt[j], d.dt[j], 1e-5f * dscale) << name(type) << " α " << alpha << " j " << j;
+                }
+                EXPECT_NEAR(c.mean, d.mean, 1e-6f);
+                EXPECT_NEAR(c.dmean, d.dmean, 1e-5f * dscale);
             }
-            EXPECT_NEAR(c.mean, d.mean, 1e-6f);
-            EXPECT_NEAR(c.dmean, d.dmean, 1e-5f * dscale);
-        }
 }
 
 TEST(RoughTransmittance, BetweenNodesWithinQuadratureAccuracy) {
@@ -53,20 +54,21 @@ TEST(RoughTransmittance, BetweenNodesWithinQuadratureAccuracy) {
     // A wrong spline derivative (a missing 1/Δs or 1/α) is off by 100% or more.
     for (MicrofacetType type : kTypes)
         for (CoatingLobe lobe : {CoatingLobe::Transmission, CoatingLobe::Reflection})
-        for (float a0 : {0.01f, 0.05f, 0.1f, 0.3f, 0.7f, 1.3f})
-            for (double x : {0.25, 0.5, 0.75}) {
-                int k = node_index(a0);
-                float alpha = float(MicrofacetDistribution::kMinAlpha * std::exp((k + x) * kStep));
-                TransmittanceTable c = rough_lobe_table(type, 1.49f, alpha, lobe), d = rough_lobe_table_direct(type, 1.49f, alpha, lobe);
-                const float dscale = max_abs(d.dt), dbound = (a0 < 0.05f ? 0.2f : 6e-2f) * dscale;
-                ASSERT_GT(dscale, 0.f);
-                for (int j = 0; j < kTransmittanceRes; ++j) {
-                    EXPECT_NEAR(c.t[j], d.t[j], 5e-4f) << name(type) << " α " << alpha << " j " << j;
-                    EXPECT_NEAR(c.dt[j], d.dt[j], dbound) << name(type) << " α " << alpha << " j " << j;
+            for (float a0 : {0.01f, 0.05f, 0.1f, 0.3f, 0.7f, 1.3f})
+                for (double x : {0.25, 0.5, 0.75}) {
+                    int k = node_index(a0);
+                    float alpha = float(MicrofacetDistribution::kMinAlpha * std::exp((k + x) * kStep));
+                    TransmittanceTable c = rough_lobe_table(type, 1.49f, alpha, lobe),
+                                       d = rough_lobe_table_direct(type, 1.49f, alpha, lobe);
+                    const float dscale = max_abs(d.dt), dbound = (a0 < 0.05f ? 0.2f : 6e-2f) * dscale;
+                    ASSERT_GT(dscale, 0.f);
+                    for (int j = 0; j < kTransmittanceRes; ++j) {
+                        EXPECT_NEAR(c.t[j], d.t[j], 5e-4f) << name(type) << " α " << alpha << " j " << j;
+                        EXPECT_NEAR(c.dt[j], d.dt[j], dbound) << name(type) << " α " << alpha << " j " << j;
+                    }
+                    EXPECT_NEAR(c.mean, d.mean, 1e-4f) << name(type) << " α " << alpha;
+                    EXPECT_NEAR(c.dmean, d.dmean, 2e-2f * dscale) << name(type) << " α " << alpha;
                 }
-                EXPECT_NEAR(c.mean, d.mean, 1e-4f) << name(type) << " α " << alpha;
-                EXPECT_NEAR(c.dmean, d.dmean, 2e-2f * dscale) << name(type) << " α " << alpha;
-            }
 }
 
 TEST(RoughTransmittance, EachNodeIsBuiltOnce) {
@@ -91,7 +93,8 @@ TEST(RoughTransmittance, ConcurrentCallersSeeTheSerialTables) {
     std::vector<std::thread> threads;
     for (int t = 0; t < 4; ++t)
         threads.emplace_back([&, t] {
-            for (size_t i = t; i < alphas.size(); i += 4) par[i] = rough_transmittance(MicrofacetType::GGX, eta, alphas[i]);
+            for (size_t i = t; i < alphas.size(); i += 4)
+                par[i] = rough_transmittance(MicrofacetType::GGX, eta, alphas[i]);
         });
     for (auto& th : threads) th.join();
     for (size_t i = 0; i < alphas.size(); ++i) {

@@ -11,10 +11,12 @@ using namespace lpt;
 
 namespace {
 
-const char* kCamera = R"("camera": {"fov": 40, "width": 16, "height": 12, "to_world": {"lookat": {"origin": [0,0,-3], "target": [0,0,0], "up": [0,1,0]}}})";
+const char* kCamera =
+    R"("camera": {"fov": 40, "width": 16, "height": 12, "to_world": {"lookat": {"origin": [0,0,-3], "target": [0,0,0], "up": [0,1,0]}}})";
 
 std::string scene_json(const std::string& materials, const std::string& shapes, const std::string& extra = "") {
-    return std::string("{") + kCamera + R"(, "materials": {)" + materials + R"(}, "shapes": [)" + shapes + "]" + extra + "}";
+    return std::string("{") + kCamera + R"(, "materials": {)" + materials + R"(}, "shapes": [)" + shapes + "]" + extra +
+           "}";
 }
 
 /// Loads `json` from a temp file and returns the SceneError message ("" if it loaded).
@@ -29,7 +31,8 @@ std::string load_error(const std::string& name, const std::string& json) {
 }
 
 const std::string kWhite = R"("white": {"type": "diffuse", "reflectance": [0.5, 0.5, 0.5]})";
-const std::string kQuad = R"({"id": "q", "type": "mesh", "material": "white", "positions": [[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0]], "indices": [[0,1,2,3]]})";
+const std::string kQuad =
+    R"({"id": "q", "type": "mesh", "material": "white", "positions": [[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0]], "indices": [[0,1,2,3]]})";
 
 }  // namespace
 
@@ -54,7 +57,8 @@ TEST(JsonScene, DefinesOverrideValues) {
 
 TEST(JsonScene, TransformListComposesInOrder) {
     // scale then translate: later ops left-multiply (Mitsuba order).
-    std::string shape = R"({"id": "q", "type": "rectangle", "material": "white", "to_world": [{"scale": 2}, {"translate": [0, 0, 5]}]})";
+    std::string shape =
+        R"({"id": "q", "type": "rectangle", "material": "white", "to_world": [{"scale": 2}, {"translate": [0, 0, 5]}]})";
     Scene s = load_scene(test::write_temp_file("xf.json", scene_json(kWhite, shape)));
     EXPECT_NEAR(s.shapes[0].area(), 16.f, 1e-4f);
     EXPECT_NEAR(s.shapes[0].mesh.positions[0].z(), 5.f, 1e-6f);
@@ -84,9 +88,11 @@ TEST(JsonScene, UnknownMaterialTypeNamesField) {
 }
 
 TEST(JsonScene, MalformedNumberNamesField) {
-    std::string err = load_error("badnum.json", scene_json(R"("white": {"type": "diffuse", "reflectance": [0.5, "x", 0.5]})", kQuad));
+    std::string err =
+        load_error("badnum.json", scene_json(R"("white": {"type": "diffuse", "reflectance": [0.5, "x", 0.5]})", kQuad));
     EXPECT_NE(err.find("materials.white.reflectance"), std::string::npos) << err;
-    err = load_error("badfov.json", std::string(R"({"camera": {"fov": "wide"}, "materials": {)") + kWhite + "}, \"shapes\": [" + kQuad + "]}");
+    err = load_error("badfov.json", std::string(R"({"camera": {"fov": "wide"}, "materials": {)") + kWhite +
+                                        "}, \"shapes\": [" + kQuad + "]}");
     EXPECT_NE(err.find("camera.fov"), std::string::npos) << err;
 }
 
@@ -98,14 +104,16 @@ TEST(JsonScene, UnknownMaterialReferenceNamesShape) {
 }
 
 TEST(JsonScene, IndexOutOfRangeNamesPolygon) {
-    std::string shape = R"({"id": "q", "type": "mesh", "material": "white", "positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [[0,1,3]]})";
+    std::string shape =
+        R"({"id": "q", "type": "mesh", "material": "white", "positions": [[0,0,0],[1,0,0],[0,1,0]], "indices": [[0,1,3]]})";
     std::string err = load_error("badidx.json", scene_json(kWhite, shape));
     EXPECT_NE(err.find("shapes[0].indices[0]"), std::string::npos) << err;
     EXPECT_NE(err.find("out of range"), std::string::npos) << err;
 }
 
 TEST(JsonScene, ZeroAreaTriangleIsAnError) {
-    std::string shape = R"({"id": "q", "type": "mesh", "material": "white", "positions": [[0,0,0],[1,0,0],[2,0,0]], "indices": [[0,1,2]]})";
+    std::string shape =
+        R"({"id": "q", "type": "mesh", "material": "white", "positions": [[0,0,0],[1,0,0],[2,0,0]], "indices": [[0,1,2]]})";
     std::string err = load_error("degenerate.json", scene_json(kWhite, shape));
     EXPECT_NE(err.find("degenerate.json"), std::string::npos) << err;
     EXPECT_NE(err.find("shapes[0]"), std::string::npos) << err;
@@ -127,15 +135,18 @@ TEST(JsonScene, NanInMeshFileIsAnError) {
 }
 
 TEST(JsonScene, DuplicateIdsAndUnknownShapeTypes) {
-    EXPECT_NE(load_error("dup.json", scene_json(kWhite, kQuad + "," + kQuad)).find("duplicate shape id"), std::string::npos);
-    std::string err = load_error("torus.json", scene_json(kWhite, R"({"id": "t", "type": "torus", "material": "white"})"));
+    EXPECT_NE(load_error("dup.json", scene_json(kWhite, kQuad + "," + kQuad)).find("duplicate shape id"),
+              std::string::npos);
+    std::string err =
+        load_error("torus.json", scene_json(kWhite, R"({"id": "t", "type": "torus", "material": "white"})"));
     EXPECT_NE(err.find("shapes[0].type"), std::string::npos) << err;
     EXPECT_NE(err.find("torus"), std::string::npos) << err;
 }
 
 TEST(JsonScene, OverflowingNumberIsAnError) {
     // JSON has no NaN/Inf literal; 1e999 overflows, and the parser rejects it with a position.
-    std::string shape = R"({"id": "l", "type": "rectangle", "material": "white", "emitter": {"type": "area", "radiance": [1e999, 1, 1]}})";
+    std::string shape =
+        R"({"id": "l", "type": "rectangle", "material": "white", "emitter": {"type": "area", "radiance": [1e999, 1, 1]}})";
     std::string err = load_error("infrad.json", scene_json(kWhite, shape));
     EXPECT_NE(err.find("infrad.json"), std::string::npos) << err;
     EXPECT_NE(err.find("1e999"), std::string::npos) << err;

@@ -99,8 +99,8 @@ TEST(ObjLoader, VertexNormalWithoutTexcoord) {
 TEST(ObjLoader, PentagonIsFanTriangulated) {
     std::string obj;
     for (int k = 0; k < 5; ++k)
-        obj += "v " + std::to_string(std::cos(2 * kPi * k / 5)) + " " + std::to_string(std::sin(2 * kPi * k / 5)) +
-               " 0\n";
+        obj +=
+            "v " + std::to_string(std::cos(2 * kPi * k / 5)) + " " + std::to_string(std::sin(2 * kPi * k / 5)) + " 0\n";
     TriangleMesh m = load_obj(write_temp_file("pentagon.obj", obj + "f 1 2 3 4 5\n"));
     ASSERT_EQ(m.triangle_count(), 3u);
     EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 3, 4}));
@@ -111,7 +111,8 @@ TEST(ObjLoader, SharedTriplesAreDeduplicatedAndShapesMerged) {
     // Two objects, merged. Repeated (v, vt) pairs share a vertex; v 1 with vt 2 (written with
     // relative indices) is a new vertex at the same position.
     TriangleMesh m = load_obj(write_temp_file(
-        "dedup.obj", std::string(kQuad) + "vt 0 0\nvt 1 1\no a\nf 1/1 2/1 3/1\no b\nf 1/1 3/1 4/1\nf -4/-1 -2/1 -1/1\n"));
+        "dedup.obj",
+        std::string(kQuad) + "vt 0 0\nvt 1 1\no a\nf 1/1 2/1 3/1\no b\nf 1/1 3/1 4/1\nf -4/-1 -2/1 -1/1\n"));
     EXPECT_EQ(m.triangle_count(), 3u);
     ASSERT_EQ(m.positions.size(), 5u);
     EXPECT_EQ(m.positions[4], m.positions[0]);
@@ -137,8 +138,7 @@ TEST(ObjLoader, FaceIndexOutOfRangeIsError) {
     expect_load_error("range.obj", std::string(kQuad) + "f 1 2 3\nf 1 2 5\n",
                       {"range.obj:6", "vertex index 5 outside 1..4"});
     // Quads would go through tinyobjloader's own triangulation path, which skipped such faces.
-    expect_load_error("range_quad.obj", std::string(kQuad) + "f 1 2 3 9\n",
-                      {"range_quad.obj:5", "vertex index 9"});
+    expect_load_error("range_quad.obj", std::string(kQuad) + "f 1 2 3 9\n", {"range_quad.obj:5", "vertex index 9"});
     expect_load_error("range_vn.obj", std::string(kQuad) + "vn 0 0 1\nf 1//1 2//2 3//1\n",
                       {"range_vn.obj:6", "normal index 2 outside 1..1"});
 }
@@ -157,7 +157,7 @@ TEST(ObjLoader, ZeroAreaTriangleIsError) {
 
 TEST(ObjLoader, SharedMitsubaScenes) {
     std::string shared = lpt::test::shared_dir();
-    std::string quads = shared + "/scenes/cbox/meshes/cbox_floor.obj";         // f v v v v
+    std::string quads = shared + "/scenes/cbox/meshes/cbox_floor.obj";        // f v v v v
     std::string triples = shared + "/scenes/veach-bidir/models/Mesh000.obj";  // f v/vt/vn
     if (shared.empty() || !std::filesystem::exists(quads) || !std::filesystem::exists(triples))
         GTEST_SKIP() << "../shared cbox / veach-bidir scenes not present";
@@ -219,8 +219,9 @@ TEST(PlyLoader, BinaryLittleEndianSkipsUnknownProperties) {
 }
 
 TEST(PlyLoader, BinaryBigEndian) {
-    std::string s = "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                    "property float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n";
+    std::string s =
+        "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n";
     auto be = [&s](auto v) {
         char b[sizeof v];
         std::memcpy(b, &v, sizeof v);
@@ -271,8 +272,8 @@ std::string triangle_gltf() {
     return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
   "nodes": [{"translation": [10, 20, 30], "children": [1]}, {"mesh": 0, "scale": [2, 2, 2]}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-  "buffers": [{"byteLength": )" + std::to_string(bin.size()) +
-           R"(, "uri": "data:application/octet-stream;base64,)" + base64(bin) + R"("}],
+  "buffers": [{"byteLength": )" +
+           std::to_string(bin.size()) + R"(, "uri": "data:application/octet-stream;base64,)" + base64(bin) + R"("}],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
                   {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
@@ -434,8 +435,8 @@ TEST(MeshValidation, UnknownExtensionAndMissingFiles) {
 
 TEST(TriangleMesh, MirrorTransformKeepsGeometricNormalWithShadingNormal) {
     // A pure mirror, and a mirror mixed with non-uniform scale and rotation (det < 0 both).
-    for (const Transform& xf :
-         {Transform::scale(Vec3f(-1, 1, 1)), Transform::scale(Vec3f(2, -3, 4)) * Transform::rotate(Vec3f(1, 1, 0), 30.f)}) {
+    for (const Transform& xf : {Transform::scale(Vec3f(-1, 1, 1)),
+                                Transform::scale(Vec3f(2, -3, 4)) * Transform::rotate(Vec3f(1, 1, 0), 30.f)}) {
         TriangleMesh m = make_cube();
         m.transform(xf);
         for (size_t t = 0; t < m.triangle_count(); ++t) {

@@ -36,8 +36,12 @@ struct RectCase {
 
 // veach-bidir's Diffuse_0002 and Diffuse_0003, and a strongly sheared, mirrored-free case.
 const RectCase kRects[] = {
-    {"veach Diffuse_0002", "-1.20536e-008 0.275755 1.20536e-008 -2.48161 0 -6.64767e-009 0.152081 6 0.275754 1.20536e-008 5.2688e-016 2.5894 0 0 0 1"},
-    {"veach Diffuse_0003", "-0.0101082 0.067068 0.00138972 -2.69082 -0.0610016 -0.0070995 -0.00842772 5.10417 -0.0282857 -0.00865658 0.0176788 -3.77057 0 0 0 1"},
+    {"veach Diffuse_0002",
+     "-1.20536e-008 0.275755 1.20536e-008 -2.48161 0 -6.64767e-009 0.152081 6 0.275754 1.20536e-008 5.2688e-016 2.5894 "
+     "0 0 0 1"},
+    {"veach Diffuse_0003",
+     "-0.0101082 0.067068 0.00138972 -2.69082 -0.0610016 -0.0070995 -0.00842772 5.10417 -0.0282857 -0.00865658 "
+     "0.0176788 -3.77057 0 0 0 1"},
     {"sheared", "0.3 0.2 0.1 1 0 0.5 -0.4 2 0 0 2 -1 0 0 0 1"},
 };
 
@@ -45,8 +49,11 @@ const RectCase kRects[] = {
 
 TEST(ClosedForm, RectangleEmitterAreaNormalAndPdfUnderScaleAndShear) {
     for (const RectCase& rc : kRects) {
-        Scene s = load_xml("rect.xml", std::string(R"(<shape type="rectangle" id="light"><transform name="to_world"><matrix value=")") +
-                                            rc.matrix + R"("/></transform><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>)");
+        Scene s =
+            load_xml("rect.xml",
+                     std::string(R"(<shape type="rectangle" id="light"><transform name="to_world"><matrix value=")") +
+                         rc.matrix +
+                         R"("/></transform><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>)");
         std::istringstream in(rc.matrix);
         Eigen::Matrix4d m;
         for (int r = 0; r < 4; ++r)
@@ -56,19 +63,22 @@ TEST(ClosedForm, RectangleEmitterAreaNormalAndPdfUnderScaleAndShear) {
         // Area of the image of [-1, 1]^2: 4 |M e_x x M e_y|.
         EXPECT_NEAR(light.area(), 4.0 * c1.cross(c2).norm(), 1e-5 * 4.0 * c1.cross(c2).norm()) << rc.name;
         // Normal: the inverse transpose of M applied to +z (Mitsuba's rectangle normal).
-        const Eigen::Vector3d n = (m.topLeftCorner<3, 3>().inverse().transpose() * Eigen::Vector3d::UnitZ()).normalized();
+        const Eigen::Vector3d n =
+            (m.topLeftCorner<3, 3>().inverse().transpose() * Eigen::Vector3d::UnitZ()).normalized();
         const PositionSample ps = light.sample_position(Eigen::Vector3f(0.3f, 0.6f, 0.2f));
         EXPECT_GT(ps.n.cast<double>().dot(n), 1.0 - 1e-6) << rc.name << ": normal " << ps.n.transpose();
         // E[1 / pdf] over light samples = solid angle, from a point on the emitting side.
         const Eigen::Vector3d size(c1.norm() + c2.norm(), 0, 0);
         const Eigen::Vector3d ref = t + 2.5 * size.x() * n + 0.3 * c1;
-        const Eigen::Vector3d p00 = t - c1 - c2 - ref, p10 = t + c1 - c2 - ref, p11 = t + c1 + c2 - ref, p01 = t - c1 + c2 - ref;
+        const Eigen::Vector3d p00 = t - c1 - c2 - ref, p10 = t + c1 - c2 - ref, p11 = t + c1 + c2 - ref,
+                              p01 = t - c1 + c2 - ref;
         const double omega = triangle_solid_angle(p00, p10, p11) + triangle_solid_angle(p00, p11, p01);
         double sum = 0, sum2 = 0;
         const int count = 100000;
         for (int i = 0; i < count; ++i) {
-            LightSample ls = sample_area_light(light, ref.cast<float>(),
-                                               Eigen::Vector3f(sample_1d(3, i, 0, 0), sample_1d(3, i, 0, 1), sample_1d(3, i, 0, 2)));
+            LightSample ls =
+                sample_area_light(light, ref.cast<float>(),
+                                  Eigen::Vector3f(sample_1d(3, i, 0, 0), sample_1d(3, i, 0, 1), sample_1d(3, i, 0, 2)));
             ASSERT_TRUE(ls.valid()) << rc.name;
             EXPECT_NEAR(ls.pdf, pdf_area_light(light, ref.cast<float>(), ls.p, ls.n), 1e-4f * ls.pdf);
             sum += 1.0 / ls.pdf;
@@ -85,8 +95,8 @@ namespace {
 const char* kTiltedTriangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0.5 0 1\nvn 0.5 0 1\nvn 0.5 0 1\nf 1//1 2//2 3//3\n";
 
 std::string obj_shape(const std::string& file, bool face_normals) {
-    return "<shape type=\"obj\" id=\"m\"><string name=\"filename\" value=\"" + file + "\"/><boolean name=\"face_normals\" value=\"" +
-           (face_normals ? "true" : "false") + "\"/></shape>";
+    return "<shape type=\"obj\" id=\"m\"><string name=\"filename\" value=\"" + file +
+           "\"/><boolean name=\"face_normals\" value=\"" + (face_normals ? "true" : "false") + "\"/></shape>";
 }
 
 }  // namespace
@@ -106,14 +116,16 @@ TEST(ClosedForm, FaceNormalsReplaceObjVertexNormals) {
 TEST(ClosedForm, ObjWithoutNormalsIsSmoothShadedAsMitsuba3) {
     // A roof: two triangles folded 90 degrees along the shared edge (0,0,0)-(0,1,0). At a shared
     // vertex each face contributes its unit normal times its interior angle there.
-    const std::string roof = test::write_temp_file("roof.obj", "v 0 0 0\nv 0 1 0\nv -1 0 -1\nv 1 0 -1\nf 1 2 3\nf 1 4 2\n");
+    const std::string roof =
+        test::write_temp_file("roof.obj", "v 0 0 0\nv 0 1 0\nv -1 0 -1\nv 1 0 -1\nf 1 2 3\nf 1 4 2\n");
     Scene s = load_xml("roof.xml", obj_shape(roof, false));
     const TriangleMesh& m = s.shapes[0].mesh;
     ASSERT_EQ(m.normals.size(), 4u);
     const Vec3f n1 = (m.positions[1] - m.positions[0]).cross(m.positions[2] - m.positions[0]).normalized();
     const Vec3f n2 = (m.positions[3] - m.positions[0]).cross(m.positions[1] - m.positions[0]).normalized();
     auto angle = [&](int at, int a, int b) {
-        const Vec3f u = (m.positions[a] - m.positions[at]).normalized(), v = (m.positions[b] - m.positions[at]).normalized();
+        const Vec3f u = (m.positions[a] - m.positions[at]).normalized(),
+                    v = (m.positions[b] - m.positions[at]).normalized();
         return std::acos(std::clamp(u.dot(v), -1.f, 1.f));
     };
     const Vec3f expect0 = (angle(0, 1, 2) * n1 + angle(0, 3, 1) * n2).normalized();
