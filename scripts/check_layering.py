@@ -2,7 +2,7 @@
 """Fails on an include that climbs the layers, or on torch outside the folders that hide it.
 
 Layers, lowest first (docs/architecture.md):
-    core -> integrators -> latent -> autodiff -> vae -> refiner -> pipeline -> apps
+    core -> integrators -> latent -> autodiff -> vae -> refiner -> pipeline -> apps | python
 A file may include its own folder and any folder below it. Tests in tests/<folder>/ follow their
 folder's rule. Only vae/ and refiner/ .cpp files (and their *_torch.h headers) may include torch:
 every other header stays torch-free, so core and the renderers build and start without libtorch.
@@ -17,6 +17,7 @@ import sys
 
 LAYERS = ["core", "integrators", "latent", "autodiff", "vae", "refiner", "pipeline", "apps"]
 RANK = {name: i for i, name in enumerate(LAYERS)}
+RANK["python"] = RANK["apps"]  # the Python module sits beside the CLI: both call pipeline/, neither the other
 TORCH_FOLDERS = {"vae", "refiner"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 SOURCE_EXT = (".h", ".hpp", ".cpp", ".cc")
@@ -27,6 +28,8 @@ def folder_of(rel_path):
     parts = rel_path.split(os.sep)
     if parts[0] == "tests" and len(parts) > 2:
         parts = parts[1:]
+    if parts[0] == "python":
+        return "python"
     return parts[0] if parts[0] in RANK else None
 
 
@@ -39,7 +42,7 @@ def torch_allowed(rel_path, layer):
 
 def violations(root):
     found = []
-    for top in LAYERS + ["tests"]:
+    for top in LAYERS + ["python", "tests"]:
         for dirpath, _, files in os.walk(os.path.join(root, top)):
             for name in sorted(files):
                 if not name.endswith(SOURCE_EXT):

@@ -12,7 +12,7 @@ import os
 import re
 import sys
 
-FOLDERS = ["core", "integrators", "latent", "autodiff", "vae", "refiner", "pipeline", "apps", "tests"]
+FOLDERS = ["core", "integrators", "latent", "autodiff", "vae", "refiner", "pipeline", "apps", "python", "tests"]
 CONTROL = re.compile(r"\b(if|for|while|switch|catch|do|else)\b\s*(\(.*\))?\s*$")
 CONTAINER = re.compile(r"\b(namespace|class|struct|union|enum)\b")
 

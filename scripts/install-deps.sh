@@ -6,6 +6,7 @@
 #  - python3-torch: only for tools/export_*.py (TorchScript VAEs) and the test that exports
 #    TAESD3 and checks the TorchScript path against the native one.
 #  - clang-format-14: the format check in ctest (.clang-format).
+#  - pybind11-dev, python3-dev, python3-numpy: `import latentpt` (python/, docs/python.md).
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build ccache pkg-config
@@ -16,6 +17,7 @@ pkgs=(
   libgtest-dev libbenchmark-dev
   python3-torch
   clang-format-14
+  pybind11-dev python3-dev python3-numpy
 )
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi

@@ -1,0 +1,164 @@
+// latentpt.fit / refine / render_edits and latentpt.Vae: the pipeline library with Python
+// progress callbacks (returning False cancels: latentpt.Cancelled is raised) and the VAE on arrays.
+#include "bindings.h"
+#include "pipeline/edit.h"
+#include "pipeline/fit.h"
+#include "pipeline/refine.h"
+#include "pipeline/vae_source.h"
+#include "vae/vae.h"
+#include <pybind11/stl.h>
+
+namespace lpt::python {
+
+namespace {
+
+/// Calls `progress(dict)` after every step (a falsy return cancels) and `note(str)` for notes;
+/// without a note callback notes go to Python's stderr.
+pipeline::Reporter reporter(const py::object& progress, const py::object& note) {
+    pipeline::Reporter r;
+    if (!progress.is_none())
+        r.progress = [progress](const pipeline::StageProgress& p) {
+            py::dict d;
+            d["stage"] = p.stage;
+            d["step"] = p.step;
+            d["total"] = p.total;
+            d["start"] = p.start;
+            d["seconds"] = p.seconds;
+            d["status"] = p.status;
+            const py::object keep = progress(d);
+            return keep.is_none() || keep.cast<bool>();
+        };
+    r.note = [note](const std::string& text) {
+        if (note.is_none()) py::print(text, py::arg("file") = py::module_::import("sys").attr("stderr"));
+        else note(text);
+    };
+    return r;
+}
+
+/// Sets the job fields named in `options` (the CLI's option names with underscores).
+void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
+    for (const auto& [key, value] : options) {
+        const std::string k = py::str(key);
+        FitOptions& o = job.options;
+        if (k == "iterations") o.iterations = value.cast<int>();
+        else if (k == "spp") o.spp = value.cast<int>();
+        else if (k == "seed") o.seed = value.cast<uint64_t>();
+        else if (k == "lr") o.lr = value.cast<float>();
+        else if (k == "lr_min") o.lr_min = value.cast<float>();
+        else if (k == "lr_period") o.lr_period = value.cast<int>();
+        else if (k == "patience") o.patience = value.cast<int>();
+        else if (k == "reuse_paths") o.reuse_paths = value.cast<int>();
+        else if (k == "checkpoint_every") o.checkpoint_every = value.cast<int>();
+        else if (k == "tone") o.tone = parse_tone_curve(value.cast<std::string>());
+        else if (k == "final_spp") job.final_spp = value.cast<int>();
+        else if (k == "target") job.target = value.cast<std::string>();
+        else if (k == "encode") job.encode = value.cast<bool>();
+        else if (k == "encode_res") job.encode_res = value.cast<std::string>();
+        else if (k == "ref_spp") job.ref_spp = value.cast<int>();
+        else if (k == "synthetic_res") job.synthetic_res = value.cast<std::string>();
+        else if (k == "param") job.param = value.cast<std::string>();
+        else if (k == "gate") job.gate = value.cast<std::string>();
+        else if (k == "terms") job.terms = value.cast<std::string>();
+        else if (k == "resume") job.resume = value.cast<bool>();
+        else if (k == "refiner") job.refiner = value.cast<bool>();
+        else if (k == "refiner_iterations") job.refine.train.iterations = value.cast<int>();
+        else if (k == "refiner_expansion") job.refine.net.expansion = value.cast<int>();
+        else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
+        else throw py::type_error("fit() got an unknown option '" + k + "'");
+    }
+}
+
+py::dict run_fit(const std::string& scene, const std::string& out, const std::map<std::string, std::string>& defines,
+                 const py::object& progress, const py::object& note, const py::kwargs& options) {
+    pipeline::FitJob job;
+    job.scene = scene;
+    job.out = out;
+    job.defines = defines;
+    apply_fit_options(job, options);
+    pipeline::validate(job);
+    const pipeline::FitSummary s = pipeline::run_fit(job, reporter(progress, note));
+    py::dict d;
+    d["latent_width"] = s.latent_width;
+    d["latent_height"] = s.latent_height;
+    d["final_loss"] = s.final_loss;
+    d["iterations_run"] = s.state.next_iteration;
+    d["best_iteration"] = s.state.best_iteration;
+    if (s.refined) d["metrics"] = py::module_::import("json").attr("loads")(s.refined->metrics.dump());
+    return d;
+}
+
+py::dict run_refine(const std::string& fitdir, int iterations, bool resume, const py::object& progress,
+                    const py::object& note) {
+    pipeline::RefineJob job;
+    job.fitdir = fitdir;
+    job.train.iterations = iterations;
+    job.resume = resume;
+    const pipeline::RefineSummary s = pipeline::run_refine(job, reporter(progress, note));
+    return py::module_::import("json").attr("loads")(s.metrics.dump());
+}
+
+int render_edits(const std::string& fitdir, const std::string& edits, const std::string& out, int spp, uint64_t seed,
+                 bool reference, const py::object& progress, const py::object& note) {
+    pipeline::EditJob job;
+    job.fitdir = fitdir;
+    job.edits = edits;
+    job.out = out;
+    job.spp = spp;
+    job.seed = seed;
+    job.reference = reference;
+    return pipeline::render_edits(job, reporter(progress, note));
+}
+
+struct PyVae {
+    std::shared_ptr<Vae> vae;
+};
+
+py::array_t<float> encode(const PyVae& v, const py::array_t<float, py::array::c_style | py::array::forcecast>& rgb) {
+    if (rgb.ndim() != 3 || rgb.shape(2) != 3) throw py::value_error("encode: expected an (height, width, 3) array");
+    const int h = int(rgb.shape(0)), w = int(rgb.shape(1)), f = v.vae->convention().downsample;
+    std::vector<float> in(rgb.data(), rgb.data() + rgb.size()), out;
+    {
+        py::gil_scoped_release unlocked;
+        out = v.vae->encode(in, w, h);
+    }
+    return to_numpy(std::move(out), {h / f, w / f, v.vae->convention().channels});
+}
+
+py::array_t<float> decode(const PyVae& v, const py::array_t<float, py::array::c_style | py::array::forcecast>& latent) {
+    if (latent.ndim() != 3 || latent.shape(2) != v.vae->convention().channels)
+        throw py::value_error("decode: expected a (height, width, " + std::to_string(v.vae->convention().channels) +
+                              ") array");
+    const int h = int(latent.shape(0)), w = int(latent.shape(1)), f = v.vae->convention().downsample;
+    std::vector<float> in(latent.data(), latent.data() + latent.size()), out;
+    {
+        py::gil_scoped_release unlocked;
+        out = v.vae->decode(in, w, h);
+    }
+    return to_numpy(std::move(out), {h * f, w * f, 3});
+}
+
+}  // namespace
+
+void bind_pipeline(py::module_& m) {
+    m.def(
+        "fit", &run_fit, py::arg("scene"), py::arg("out"), py::arg("defines") = std::map<std::string, std::string>{},
+        py::arg("progress") = py::none(), py::arg("note") = py::none(),
+        "Stage 1 (and stage 2 unless refiner=False) into the fit folder `out`; keyword options as the CLI's "
+        "(iterations, spp, seed, lr, encode, encode_res, synthetic_res, param, gate, terms, refiner_iterations, ...).");
+    m.def("refine", &run_refine, py::arg("fitdir"), py::arg("iterations") = 3000, py::arg("resume") = false,
+          py::arg("progress") = py::none(), py::arg("note") = py::none(),
+          "Stage 2 on a fit folder; returns metrics.json.");
+    m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
+          py::arg("seed") = 0, py::arg("reference") = false, py::arg("progress") = py::none(),
+          py::arg("note") = py::none(),
+          "A fit's edit sequence (edits.json, as `render --edit`); returns the number of frames.");
+    py::class_<PyVae>(m, "Vae", "An image autoencoder: TAESD3 weights in a folder (default ../shared/models/taesd3).")
+        .def(py::init([](const std::string& dir) {
+                 return PyVae{std::shared_ptr<Vae>(pipeline::open_vae({dir, "", "", ""}))};
+             }),
+             py::arg("dir") = "")
+        .def("encode", &encode, py::arg("rgb"), "Display RGB in [0, 1], (H, W, 3) -> latent (H/8, W/8, 16).")
+        .def("decode", &decode, py::arg("latent"), "Latent (h, w, 16) -> display RGB (8h, 8w, 3).");
+}
+
+}  // namespace lpt::python

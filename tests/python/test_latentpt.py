@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""`import latentpt` from the build tree: scenes, latent renders, the torch autograd function
+against finite differences, the pipeline with a progress callback and a cancel, and torch and
+latentpt in one process. Run by ctest (python.module) with PYTHONPATH=<build>/python."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+import latentpt
+
+SRC = os.environ.get("LATENTPT_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+BOX = os.path.join(SRC, "scenes", "cornell-box", "scene.json")
+# Russian roulette off and short paths: every sampling decision is independent of the latent
+# values, so the primal with fixed random numbers is smooth in them and central differences apply.
+SMOOTH = {"integrator.max_depth": "3", "integrator.rr_depth": "100", "camera.width": "8", "camera.height": "8"}
+
+
+def torch_or_skip():
+    try:
+        import torch  # noqa: F401
+        import latentpt.torch  # noqa: F401
+        return torch
+    except ImportError as e:
+        raise unittest.SkipTest(f"torch is not importable: {e}")
+
+
+class SceneTest(unittest.TestCase):
+    def test_render_is_an_array_of_the_asked_size(self):
+        scene = latentpt.Scene(BOX)
+        img = scene.render(spp=2, width=24, height=16)
+        self.assertEqual(img.shape, (16, 24, 3))
+        self.assertEqual(img.dtype, np.float32)
+        self.assertTrue(np.isfinite(img).all())
+        self.assertGreater(img.mean(), 0.0)
+        np.testing.assert_array_equal(img, scene.render(spp=2, width=24, height=16))  # deterministic seed
+
+    def test_bad_scene_raises_with_the_file_name(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "bad.json")
+            with open(path, "w") as f:
+                f.write('{"camera": {"fov": 40}, "shapes": [{"type": "obj", "filename": "nope.obj", "material": "m"}],'
+                        ' "materials": {"m": {"type": "diffuse"}}}')
+            with self.assertRaises(latentpt.SceneError) as ctx:
+                latentpt.Scene(path)
+            self.assertIn("nope.obj", str(ctx.exception))
+
+    def test_defines_override_scene_values(self):
+        scene = latentpt.Scene(BOX, defines={"camera.width": "10", "camera.height": "6"})
+        self.assertEqual((scene.width, scene.height), (10, 6))
+
+
+class LatentTest(unittest.TestCase):
+    def setUp(self):
+        self.model = latentpt.LatentScene(latentpt.Scene(BOX, defines=SMOOTH), seed=3)
+
+    def test_named_values_round_trip(self):
+        names = [s["name"] for s in self.model.slices()]
+        self.assertIn("light.Le", names)
+        v = np.linspace(-0.5, 0.5, 16, dtype=np.float32)
+        self.model.set_value("floor.La", v)
+        np.testing.assert_allclose(self.model.value("floor.La"), v, atol=1e-6)
+        with self.assertRaises(KeyError):
+            self.model.value("no.such")
+
+    def test_adjoint_matches_central_differences(self):
+        m = self.model
+        rng = np.random.default_rng(1)
+        w = rng.uniform(-1, 1, (m.height, m.width, 16)).astype(np.float32)
+        # Before the tone curve: its x^(1/2.2) is singular at 0, where fresh L̃a values start.
+        loss = lambda: float((w * m.render_linear(spp=4, seed=7)).sum(dtype=np.float64))  # noqa: E731
+        grad = m.backward_linear(w, spp=4, seed=7)
+        raw0 = m.raw.copy()
+        checked = 0
+        for s in m.slices():
+            if s["name"] not in ("light.Le", "floor.La", "back.Lc", "red_wall.bsdf.reflectance", "background"):
+                continue
+            for k in (0, 5):
+                i = s["raw_offset"] + k
+                h = 1e-2
+                up, down = raw0.copy(), raw0.copy()
+                up[i] += h
+                down[i] -= h
+                m.raw = up
+                lp = loss()
+                m.raw = down
+                lm = loss()
+                fd = (lp - lm) / (2 * h)
+                self.assertLess(abs(grad[i] - fd), 2e-2 * max(1.0, abs(fd)), f"{s['name']}[{k}]: adjoint {grad[i]} fd {fd}")
+                checked += 1
+        m.raw = raw0
+        self.assertGreaterEqual(checked, 8)
+
+    def test_torch_function_backward_is_the_adjoint(self):
+        torch = torch_or_skip()
+        import latentpt.torch as lt
+        m = self.model
+        raw = lt.raw_parameters(m)
+        latent = lt.render_latent(m, raw, spp=4, seed=7)
+        self.assertEqual(tuple(latent.shape), (m.height, m.width, 16))
+        w = torch.from_numpy(np.random.default_rng(2).uniform(-1, 1, tuple(latent.shape)).astype(np.float32))
+        (w * latent).sum().backward()
+        m.raw = raw.detach().numpy()
+        expected = m.backward_linear(m.tone_backward(m.render_linear(spp=4, seed=7), w.numpy()), spp=4, seed=7)
+        np.testing.assert_allclose(raw.grad.numpy(), expected, rtol=1e-6, atol=1e-9)
+
+
+class GuidanceTest(unittest.TestCase):
+    """An SDS-shaped loop with a stand-in guide: the latent pixels where one object is seen are
+    pulled towards the VAE encoding of a flat colour. Like the paper's teapot example, the
+    object's own parameters should take the change and everything else stay nearly put."""
+
+    def test_guide_moves_the_seen_object_and_little_else(self):
+        torch = torch_or_skip()
+        import latentpt.torch as lt
+        shared = os.environ.get("LATENTPT_SHARED", os.path.join(SRC, "..", "shared"))
+        if not os.path.exists(os.path.join(shared, "models", "taesd3", "taesd3_encoder.safetensors")):
+            self.skipTest("no TAESD3 weights in ../shared")
+        defines = dict(SMOOTH, **{"camera.width": "16", "camera.height": "16"})
+        m = latentpt.LatentScene(latentpt.Scene(defines=defines, path=BOX), seed=3)
+        # Where the short block is seen: the pixels its L̃a reaches.
+        before = m.render_linear(spp=4, seed=1)
+        m.set_value("short_block.La", np.full(16, 5.0, np.float32))
+        mask = np.abs(m.render_linear(spp=4, seed=1) - before).max(axis=2) > 1e-3
+        m.set_value("short_block.La", np.zeros(16, np.float32))
+        self.assertGreater(mask.sum(), 3)
+        red = np.zeros((128, 128, 3), np.float32)
+        red[..., 0] = 0.8
+        target = torch.from_numpy(latentpt.Vae(os.path.join(shared, "models", "taesd3")).encode(red))
+        mask_t = torch.from_numpy(mask)
+        raw = lt.raw_parameters(m)
+        start = raw.detach().clone()
+        # Plain gradient steps: Adam would move every parameter with any gradient at the same rate.
+        opt = torch.optim.SGD([raw], lr=0.5)
+        losses = []
+        for it in range(30):
+            opt.zero_grad()
+            latent = lt.render_latent(m, raw, spp=4, seed=it)
+            loss = ((latent - target)[mask_t] ** 2).mean()
+            loss.backward()
+            opt.step()
+            losses.append(float(loss))
+        self.assertLess(np.mean(losses[-5:]), 0.5 * np.mean(losses[:3]), losses)
+        moved = (raw.detach() - start).abs().numpy()
+        own = np.zeros(moved.size, bool)
+        for s in m.slices():
+            if s["name"].startswith("short_block."):
+                own[s["raw_offset"]:s["raw_offset"] + s["raw_size"]] = True
+        ratio = moved[own].mean() / max(moved[~own].mean(), 1e-12)
+        self.assertGreater(ratio, 5.0, f"the block's parameters moved {moved[own].mean():.4f}, the rest "
+                                       f"{moved[~own].mean():.4f}")
+
+
+class PipelineTest(unittest.TestCase):
+    def test_fit_reports_progress_and_cancels_cleanly(self):
+        with tempfile.TemporaryDirectory() as d:
+            steps = []
+            summary = latentpt.fit(BOX, os.path.join(d, "fit"), defines={"integrator.max_depth": "3"},
+                                   progress=lambda p: steps.append(p["step"]), note=lambda t: None,
+                                   synthetic_res="8x8", iterations=12, spp=2, final_spp=4, refiner=False)
+            self.assertEqual(steps, list(range(1, 13)))
+            self.assertEqual(summary["iterations_run"], 12)
+            model = latentpt.LatentScene.from_fit(os.path.join(d, "fit"))
+            self.assertEqual(model.render(spp=2).shape, (8, 8, 16))
+            cancelled = os.path.join(d, "cancelled")
+            with self.assertRaises(latentpt.Cancelled):
+                latentpt.fit(BOX, cancelled, progress=lambda p: p["step"] < 5, note=lambda t: None,
+                             synthetic_res="8x8", iterations=12, spp=2, refiner=False)
+            self.assertFalse(os.path.exists(os.path.join(cancelled, "params.json")))
+            with self.assertRaises(TypeError):
+                latentpt.fit(BOX, cancelled, no_such_option=1)
+
+
+class OneProcessTest(unittest.TestCase):
+    def test_torch_and_latentpt_load_together_in_either_order(self):
+        torch_or_skip()
+        for first, second in (("torch", "latentpt"), ("latentpt", "torch")):
+            code = (f"import {first}, {second}, latentpt.torch, numpy, torch; "
+                    "s = latentpt.Scene(sys.argv[1]); print(float(s.render(spp=1, width=8, height=8).mean()))")
+            r = subprocess.run([sys.executable, "-c", "import sys; " + code, BOX], capture_output=True, text=True,
+                               env=os.environ.copy())
+            self.assertEqual(r.returncode, 0, f"import {first} then {second}: {r.stderr}")
+            self.assertGreater(float(r.stdout.strip()), 0.0)
+
+
+if __name__ == "__main__":
+    unittest.main()
