@@ -10,6 +10,27 @@
 namespace lpt::app {
 namespace {
 
+/// A number that must be > 0 (strict) or >= 0; CLI11's own validators print their range as
+/// "0 to 1.8e308" in full.
+CLI::Validator bounded_below(bool strict) {
+    return CLI::Validator(
+        [strict](std::string& text) -> std::string {
+            double v = 0;
+            try {
+                size_t used = 0;
+                v = std::stod(text, &used);
+                if (used != text.size()) return "expected a number, got '" + text + "'";
+            } catch (const std::exception&) {
+                return "expected a number, got '" + text + "'";
+            }
+            if (strict ? v > 0 : v >= 0) return "";
+            return std::string("must be ") + (strict ? "> 0" : ">= 0") + ", got " + text;
+        },
+        strict ? "> 0" : ">= 0");
+}
+CLI::Validator positive() { return bounded_below(true); }
+CLI::Validator non_negative() { return bounded_below(false); }
+
 /// The autoencoder: native TAESD3 weights, or any VAE exported to TorchScript (tools/export_vae.py).
 void add_vae_options(CLI::App* sc, VaeSource& vs) {
     sc->add_option("--vae-dir", vs.dir,
@@ -25,24 +46,43 @@ void add_vae_options(CLI::App* sc, VaeSource& vs) {
 
 /// Stage-2 options: `--refiner-<name>` on fit, `--<name>` on refine.
 void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string& pre) {
-    sc->add_option("--" + pre + "iterations", ra.train.iterations, "refiner training steps")->capture_default_str();
+    sc->add_option("--" + pre + "iterations", ra.train.iterations, "refiner training steps")
+        ->capture_default_str()
+        ->check(positive());
     sc->add_option("--" + pre + "expansion", ra.net.expansion, "refiner width = expansion x 16 channels")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(positive());
     sc->add_option("--" + pre + "crop", ra.train.crop, "latent crop side per refiner step (0 = the whole view)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(non_negative());
     sc->add_option("--" + pre + "lpips-crop", ra.train.lpips_crop,
                    "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")
+        ->capture_default_str()
+        ->check(non_negative());
+    sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")
+        ->capture_default_str()
+        ->check(positive());
+    sc->add_option("--" + pre + "patience", ra.train.patience,
+                   "refiner early stopping on the smoothed loss->check(non_negative()); 0 = off")
         ->capture_default_str();
-    sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")->capture_default_str();
-    sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")
-        ->capture_default_str();
-    sc->add_option("--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE")->capture_default_str();
-    sc->add_option("--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM")->capture_default_str();
-    sc->add_option("--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops")->capture_default_str();
-    sc->add_option("--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)")->capture_default_str();
-    sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")->capture_default_str();
+    sc->add_option("--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE")
+        ->capture_default_str()
+        ->check(non_negative());
+    sc->add_option("--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM")
+        ->capture_default_str()
+        ->check(non_negative());
+    sc->add_option("--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops")
+        ->capture_default_str()
+        ->check(non_negative());
+    sc->add_option("--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)")
+        ->capture_default_str()
+        ->check(positive());
+    sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 0.99));
     sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(non_negative());
     sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
 }
 
@@ -75,17 +115,20 @@ struct Cli {
             ->check(CLI::ExistingFile);
         render->add_flag("--reference", r.reference,
                          "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv");
-        render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")->capture_default_str();
+        render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")
+            ->capture_default_str()
+            ->check(positive());
         render->add_option("--reference-cache", r.reference_cache,
                            "with --reference: keep path-traced frames in this folder and reuse them "
                            "(keyed by edits file name, size, spp, tone and frame)");
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
-        render->add_option("--spp", r.spp, "samples per pixel (default: the scene's)");
+        render->add_option("--spp", r.spp, "samples per pixel (default and 0: the scene's)")->check(non_negative());
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");
         render->add_option("--seed", r.seed, "random seed: same seed, same image, at any thread count")
             ->capture_default_str();
-        render->add_option("--max-depth", r.max_depth,
-                           "longest path in segments, -1 = unbounded (default: the scene's)");
+        render
+            ->add_option("--max-depth", r.max_depth, "longest path in segments, -1 = unbounded (default: the scene's)")
+            ->check(CLI::Range(-1, 1 << 20));
         render->add_option("--strategy", r.strategy, "light estimator: mis (NEE + BSDF sampling), nee, bsdf")
             ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
             ->capture_default_str();
@@ -101,25 +144,31 @@ struct Cli {
         bench = app.add_subcommand("bench",
                                    "rays/s of the path tracer next to raw Embree throughput on the same ray counts");
         bench->add_option("--scene", b.scene, "scene (default: scenes/cornell-box/scene.json)");
-        bench->add_option("--spp", b.spp, "samples per pixel")->capture_default_str();
-        bench->add_option("--res", b.res, "square resolution")->capture_default_str();
+        bench->add_option("--spp", b.spp, "samples per pixel")->capture_default_str()->check(positive());
+        bench->add_option("--res", b.res, "square resolution")->capture_default_str()->check(positive());
         bench
             ->add_option("--sphere-triangles", b.sphere_triangles,
                          "triangles of the sphere added for the heavy-scene run")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(positive());
         bench->add_option("--json", b.out_json, "also write the results as JSON");
         bench->add_flag("--fit", b.fit, "time fit iterations (forward and adjoint) at latent resolution instead");
         bench->add_option("--fit-scene", b.fit_scene,
                           "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)");
-        bench->add_option("--fit-res", b.fit_res, "latent resolution for --fit")->capture_default_str();
-        bench->add_option("--fit-spp", b.fit_spp, "samples per pixel per iteration for --fit")->capture_default_str();
+        bench->add_option("--fit-res", b.fit_res, "latent resolution for --fit")
+            ->capture_default_str()
+            ->check(positive());
+        bench->add_option("--fit-spp", b.fit_spp, "samples per pixel per iteration for --fit")
+            ->capture_default_str()
+            ->check(positive());
         bench
             ->add_option("--equal-error", b.equal_error,
                          "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
                          "the same latent error, and latent + decode vs RGB for the same image error")
             ->check(CLI::ExistingDirectory);
         bench->add_option("--max-spp", b.max_spp, "with --equal-error: highest RGB spp (latent side: a quarter)")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(positive());
         bench->add_flag("--equal-noise", b.equal_noise,
                         "spp and render seconds to one noise level, Sobol vs independent sampler, against a converged "
                         "reference (default scene: ../shared cornell-box scene_v3.xml; docs/sampling.md)");
@@ -130,10 +179,11 @@ struct Cli {
         bench
             ->add_option("--target-spp", b.target_spp,
                          "with --equal-noise: target = the independent sampler's noise at this spp (4 ... 256)")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(CLI::Range(4, 256));
         bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")
             ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+            ->check(positive());
     }
 
     void add_fit(CLI::App& app) {
@@ -150,21 +200,33 @@ struct Cli {
             ->capture_default_str();
         fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
             ->capture_default_str();
-        fit->add_option("--iterations", f.job.options.iterations, "optimiser steps")->capture_default_str();
-        fit->add_option("--spp", f.job.options.spp, "samples per pixel per iteration")->capture_default_str();
-        fit->add_option("--final-spp", f.job.final_spp, "samples per pixel of the final render")->capture_default_str();
+        fit->add_option("--iterations", f.job.options.iterations, "optimiser steps")
+            ->capture_default_str()
+            ->check(positive());
+        fit->add_option("--spp", f.job.options.spp, "samples per pixel per iteration")
+            ->capture_default_str()
+            ->check(positive());
+        fit->add_option("--final-spp", f.job.final_spp, "samples per pixel of the final render")
+            ->capture_default_str()
+            ->check(positive());
         fit->add_option("--seed", f.job.options.seed, "seed of the initial parameters and of every iteration's paths")
             ->capture_default_str();
         fit->add_option("--lr", f.job.options.lr, "Adam learning rate (cosine annealing with warm restarts)")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(positive());
         fit->add_option("--lr-min", f.job.options.lr_min, "minimum learning rate of the schedule")
-            ->capture_default_str();
-        fit->add_option("--lr-period", f.job.options.lr_period, "iterations per restart period")->capture_default_str();
+            ->capture_default_str()
+            ->check(non_negative());
+        fit->add_option("--lr-period", f.job.options.lr_period, "iterations per restart period")
+            ->capture_default_str()
+            ->check(positive());
         fit->add_option("--patience", f.job.options.patience,
-                        "early stopping: iterations without improvement of the smoothed loss; 0 = off")
+                        "early stopping: iterations without improvement of the smoothed "
+                        "loss->check(non_negative()); 0 = off")
             ->capture_default_str();
         fit->add_option("--min-delta", f.job.options.min_delta, "early stopping: smallest improvement that counts")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(non_negative());
         fit->add_option("--tone", fit_tone,
                         "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
             ->check(CLI::IsMember({"clip", "reinhard", "logit"}))
@@ -180,7 +242,7 @@ struct Cli {
         fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")
             ->capture_default_str();
         fit->add_option("--checkpoint-every", f.job.options.checkpoint_every,
-                        "iterations between checkpoints; 0 = only at the end")
+                        "iterations between checkpoints->check(non_negative()); 0 = only at the end")
             ->capture_default_str();
         fit->add_option("--reuse-paths", f.job.options.reuse_paths,
                         "K: trace and store one frame of paths every K iterations and replay them in between (no rays; "
@@ -189,7 +251,7 @@ struct Cli {
                         "gradient (least memory). "
                         "Equal final loss for K = 0, 1, 8, 32 on the CBox (docs/fitting.md)")
             ->capture_default_str()
-            ->check(CLI::NonNegativeNumber);
+            ->check(non_negative());
         fit->add_flag("--resume", f.job.resume, "continue from <out>/checkpoint");
         fit->add_flag("--encode", f.job.encode,
                       "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
@@ -265,19 +327,20 @@ struct Cli {
             ->add_option("--scene", cmp.scene, "scene of the renders: pixels that see an emitter directly are left out")
             ->check(CLI::ExistingFile);
         compare->add_option("-D,--define", cmp_defines, "scene override, as for render");
-        compare->add_option("--block", cmp.block, "block side in pixels")
-            ->capture_default_str()
-            ->check(CLI::PositiveNumber);
+        compare->add_option("--block", cmp.block, "block side in pixels")->capture_default_str()->check(positive());
         compare
             ->add_option("--sigma", cmp.sigma,
                          "flag blocks whose ratio is this many standard deviations of its noise from 1")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(positive());
         compare
             ->add_option("--mean-tolerance", cmp.mean_tolerance,
                          "verdict: channel means within this relative difference")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(non_negative());
         compare->add_option("--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(positive());
         compare->add_option("--exposure", cmp.exposure, "exposure of the side-by-side previews in stops")
             ->capture_default_str();
         compare->add_option("-o,--out-dir", cmp.out_dir,
@@ -333,7 +396,7 @@ int main(int argc, char** argv) {
     lpt::app::Cli cli;
     CLI::App app{"latentpt: a differentiable path tracer that renders into the latent space of an image autoencoder"};
     app.require_subcommand(1);
-    app.add_option("--threads", cli.threads, "worker threads (default: all cores)");
+    app.add_option("--threads", cli.threads, "worker threads (default: all cores)")->check(lpt::app::positive());
     app.add_option("--sampler", cli.sampler,
                    "random numbers of every render: sobol (Owen-scrambled, low discrepancy) or independent "
                    "(default: the scene's; docs/sampling.md)")

@@ -7,11 +7,16 @@
 
 namespace lpt {
 
+/// Throws std::length_error naming the size and the bytes it would need when a width x height
+/// image of `floats_per_pixel` floats (its film and its developed copy) cannot fit in this
+/// machine's memory, or when a side is not positive: a clear error instead of std::bad_alloc.
+void check_image_fits(int width, int height, size_t floats_per_pixel);
+
 template <int N>
 class Film {
 public:
     Film(int width, int height)
-        : m_width(width),
+        : m_width((check_image_fits(width, height, 2 * N + 1), width)),
           m_height(height),
           m_sum(size_t(width) * height, Spectrum<N>::Zero()),
           m_weight(size_t(width) * height, 0.f) {}
