@@ -186,20 +186,8 @@ struct Cli {
             ->check(positive());
     }
 
-    void add_fit(CLI::App& app) {
-        fit = app.add_subcommand("fit", "fit per-shape latent parameters to a target latent map (stage 1)");
-        fit->add_option("scene", f.job.scene, "scene file (.json or Mitsuba 3 .xml)")
-            ->required()
-            ->check(CLI::ExistingFile);
-        fit->add_option("--target", f.job.target,
-                        "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
-                        "without it, a synthetic target rendered from random parameters")
-            ->check(CLI::ExistingFile);
-        fit->add_option("-o,--out", f.job.out, "output folder")->capture_default_str();
-        fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")
-            ->capture_default_str();
-        fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
-            ->capture_default_str();
+    /// The optimiser, the target's RGB reference, the VAE, stage 2: the rest of fit's options.
+    void add_fit_optimisation() {
         fit->add_option("--iterations", f.job.options.iterations, "optimiser steps")
             ->capture_default_str()
             ->check(positive());
@@ -268,6 +256,23 @@ struct Cli {
         fit->add_flag("-q,--quiet", f.quiet, "no progress line");
 
         add_refine_options(fit, f.job.refine, "refiner-");
+    }
+
+    void add_fit(CLI::App& app) {
+        fit = app.add_subcommand("fit", "fit per-shape latent parameters to a target latent map (stage 1)");
+        fit->add_option("scene", f.job.scene, "scene file (.json or Mitsuba 3 .xml)")
+            ->required()
+            ->check(CLI::ExistingFile);
+        fit->add_option("--target", f.job.target,
+                        "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
+                        "without it, a synthetic target rendered from random parameters")
+            ->check(CLI::ExistingFile);
+        fit->add_option("-o,--out", f.job.out, "output folder")->capture_default_str();
+        fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")
+            ->capture_default_str();
+        fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
+            ->capture_default_str();
+        add_fit_optimisation();
     }
 
     void add_refine(CLI::App& app) {

@@ -26,7 +26,8 @@ size_t Adam::step(float* params, const float* grads, size_t n, float lr) {
     if (!std::isfinite(lr)) throw std::invalid_argument("Adam::step: learning rate is not finite");
 
     size_t bad = 0;
-    for (size_t i = 0; i < n; ++i) bad += !std::isfinite(grads[i]);
+    // A gradient whose square overflows would make the second moment infinite for good.
+    for (size_t i = 0; i < n; ++i) bad += !std::isfinite(grads[i]) || !std::isfinite(grads[i] * grads[i]);
     if (bad > 0) return bad;
 
     const float b1 = m_config.beta1, b2 = m_config.beta2;

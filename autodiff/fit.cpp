@@ -36,6 +36,23 @@ std::vector<float> render_toned(const LatentModel& model, const RenderOptions& o
     return img;
 }
 
+namespace {
+
+/// The slice of the first raw gradient Adam refuses (NaN, Inf, or a square that overflows).
+std::string first_bad_gradient(const ParamStore& ps) {
+    const std::vector<float>& g = ps.grad_raw();
+    for (size_t i = 0; i < g.size(); ++i) {
+        if (std::isfinite(g[i]) && std::isfinite(g[i] * g[i])) continue;
+        for (size_t k = 0; k < ps.slice_count(); ++k) {
+            const ParamSlice& sl = ps.slice(int(k));
+            if (i >= sl.raw_offset && i < sl.raw_offset + sl.raw_size()) return sl.name;
+        }
+    }
+    return "?";
+}
+
+}  // namespace
+
 FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o,
                     FitState state, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
     const size_t n = size_t(width) * height * kLatentChannels;
@@ -85,7 +102,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         ps.backward();
         const float lr = schedule.lr_at(it);
         size_t bad = adam.step(ps.raw().data(), ps.grad_raw().data(), ps.raw().size(), lr);
-        if (bad) ++state.skipped_steps;  // the step was refused: parameters untouched
+        if (bad) ++state.skipped_steps;  // the step was refused: parameters and Adam state untouched
         ps.clamp_raw();
         model.sync();
 
@@ -98,7 +115,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         state.next_iteration = it + 1;
         state.adam = adam.state();
         double secs = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        FitRecord rec{it, loss, state.smoothed, lr, secs, bad != 0};
+        FitRecord rec{it, loss, state.smoothed, lr, secs, bad != 0, bad ? first_bad_gradient(ps) : std::string()};
         state.history.push_back(rec);
         if (checkpoint_every > 0 && !o.checkpoint_dir.empty() && (it + 1) % checkpoint_every == 0)
             save_checkpoint(o.checkpoint_dir, model, state);
@@ -159,8 +176,13 @@ FitState load_checkpoint(const std::string& dir, LatentModel& model) {
         s.skipped_steps = j.at("skipped_steps");
         s.best_raw = j.at("best_raw").get<std::vector<float>>();
         for (const auto& r : j.at("history"))
-            s.history.push_back({r.at(0).get<int>(), r.at(1).get<double>(), r.at(2).get<double>(), r.at(3).get<float>(),
-                                 r.at(4).get<double>()});
+            s.history.push_back({r.at(0).get<int>(),
+                                 r.at(1).get<double>(),
+                                 r.at(2).get<double>(),
+                                 r.at(3).get<float>(),
+                                 r.at(4).get<double>(),
+                                 false,
+                                 {}});
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(state_path + ": incomplete checkpoint: " + e.what());
     }

@@ -38,7 +38,8 @@ struct FitRecord {
     double loss, smoothed;
     float lr;
     double seconds;
-    bool refused = false;  ///< the gradient had NaN/Inf entries: the step was skipped
+    bool refused = false;           ///< the gradient had NaN/Inf entries: the step was skipped
+    std::string refused_parameter;  ///< when refused: the first slice with a bad gradient
 };
 
 struct FitState {

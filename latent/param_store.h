@@ -41,6 +41,7 @@ public:
     std::vector<float>& raw() { return m_raw; }
     const std::vector<float>& raw() const { return m_raw; }
     std::vector<float>& grad_raw() { return m_grad_raw; }
+    const std::vector<float>& grad_raw() const { return m_grad_raw; }
     const float* value(int slice) const { return m_value.data() + m_slices[slice].value_offset; }
     float* grad_value(int slice) { return m_grad_value.data() + m_slices[slice].value_offset; }
     const std::vector<float>& values() const { return m_value; }

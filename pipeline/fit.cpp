@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 namespace lpt::pipeline {
@@ -97,11 +98,11 @@ bool optimise(LatentModel& model, const Target& target, const FitOptions& o, Fit
     const int start = state.next_iteration;
     const double seconds_at_start = state.history.empty() ? 0.0 : state.history.back().seconds;
     bool cancelled = false;
-    auto on_iteration = [&](const FitRecord& r, const FitState& st) {
-        if (r.refused && st.skipped_steps <= 10)
-            report.say("warning: iteration " + std::to_string(r.iteration) + ": non-finite gradient, step skipped (" +
-                       std::to_string(st.skipped_steps) + " so far)" +
-                       (st.skipped_steps == 10 ? "; further warnings suppressed" : ""));
+    std::set<std::string> reported;  // once per parameter; the summary counts every refused step
+    auto on_iteration = [&](const FitRecord& r, const FitState&) {
+        if (r.refused && reported.insert(r.refused_parameter).second)
+            report.say("warning: iteration " + std::to_string(r.iteration) + ": the gradient of '" +
+                       r.refused_parameter + "' is not finite: step refused, parameters and Adam state kept");
         StageProgress p;
         p.stage = "fit";
         p.step = r.iteration + 1;

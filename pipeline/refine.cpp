@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 namespace lpt::pipeline {
@@ -130,7 +131,13 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();
     o.resume = job.resume && fs::exists(o.checkpoint_path);
     bool cancelled = false;
+    std::set<std::string> reported;  // once per weight
     auto on_iteration = [&](const RefinerRecord& r) {
+        if (r.refused && reported.insert(r.refused_parameter).second)
+            report.say("warning: refiner iteration " + std::to_string(r.iteration) + ": " +
+                       (r.refused_parameter == "loss" ? std::string("the loss")
+                                                      : "the gradient of '" + r.refused_parameter + "'") +
+                       " is not finite: step refused, weights and Adam state kept");
         StageProgress p;
         p.stage = "refine";
         p.step = r.iteration + 1;

@@ -48,6 +48,10 @@ struct RefinerTrainOptions {
 struct RefinerRecord {
     int iteration = 0;
     double loss = 0, smoothed = 0, mse = 0, dssim = 0, lpips = 0, seconds = 0;
+    /// The loss or a weight's gradient was not finite: the step was refused, weights and Adam
+    /// state kept. refused_parameter names the weight ("loss" when the loss itself was bad).
+    bool refused = false;
+    std::string refused_parameter;
 };
 
 struct RefinerTrainResult {

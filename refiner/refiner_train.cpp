@@ -74,9 +74,15 @@ void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
         ar.read("history", hist);
         for (int64_t i = 0; i < hist.size(0); ++i) {
             auto r = hist[i];
-            s.result.history.push_back({int(r[0].item<double>()), r[1].item<double>(), r[2].item<double>(),
-                                        r[3].item<double>(), r[4].item<double>(), r[5].item<double>(),
-                                        r[6].item<double>()});
+            s.result.history.push_back({int(r[0].item<double>()),
+                                        r[1].item<double>(),
+                                        r[2].item<double>(),
+                                        r[3].item<double>(),
+                                        r[4].item<double>(),
+                                        r[5].item<double>(),
+                                        r[6].item<double>(),
+                                        false,
+                                        {}});
         }
         torch::Tensor st;
         ar.read("stop", st);
@@ -189,6 +195,17 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
     return loss;
 }
 
+/// Back-propagates `loss`; returns "" when every weight's gradient is finite, else the first
+/// weight's name whose is not (the caller then skips the optimiser step).
+std::string backward_or_refuse(RefinerNet& net, torch::Tensor& loss) {
+    loss.backward();
+    for (const auto& p : net->named_parameters()) {
+        const torch::Tensor& g = p.value().grad();
+        if (g.defined() && !torch::isfinite(g).all().item<bool>()) return p.key();
+    }
+    return "";
+}
+
 }  // namespace
 
 RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<float>& target,
@@ -208,11 +225,12 @@ RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<f
         s.adam.zero_grad();
         RefinerRecord r;
         torch::Tensor loss = crop_loss(net, data, o, it, r);
-        if (!std::isfinite(r.loss))
-            throw std::runtime_error("refiner: loss became non-finite at iteration " + std::to_string(it));
-        loss.backward();
-        s.adam.step();
-        s.smoothed = it == 0 ? r.loss : kSmoothing * s.smoothed + (1 - kSmoothing) * r.loss;
+        r.refused_parameter = std::isfinite(r.loss) ? backward_or_refuse(net, loss) : "loss";
+        r.refused = !r.refused_parameter.empty();
+        if (!r.refused) {
+            s.adam.step();
+            s.smoothed = it == 0 ? r.loss : kSmoothing * s.smoothed + (1 - kSmoothing) * r.loss;
+        }
         r.smoothed = s.smoothed;
         r.seconds = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         s.result.history.push_back(r);

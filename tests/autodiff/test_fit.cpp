@@ -143,3 +143,28 @@ TEST(Fit, RejectsNonFiniteOrMisshapenTargets) {
     }
     EXPECT_THROW(fit_latent(m, std::vector<float>(10), kRes, kRes, fit_options(1)), std::invalid_argument);
 }
+
+// A step whose gradient is not finite is refused and named; the parameters stay as they were.
+// Injected: an emitter so bright (1e25, reachable by the paper's pos - neg map) that the
+// reflectance gradients' squares overflow float.
+TEST(Fit, NonFiniteStepsAreRefusedNamedAndLeaveTheParameters) {
+    Scene scene = cornell();
+    LatentModel m(scene, Parameterisation::Paper, 2);
+    const int le = m.params().find("light.Le");
+    ASSERT_GE(le, 0);
+    const std::vector<float> bright(kLatentChannels, 1e25f);
+    m.params().set_value(le, bright.data());
+    m.sync();
+    const std::vector<float> raw_before = m.params().raw();
+    const std::vector<float> target(size_t(kRes) * kRes * kLatentChannels, 0.f);
+    FitOptions o = fit_options(3);
+    o.tone = ToneCurve::None;  // the Huber loss bounds dloss/dlatent; the size comes from L̃e
+    const FitState st = fit_latent(m, target, kRes, kRes, o);
+    ASSERT_EQ(st.history.size(), 3u);
+    for (const FitRecord& r : st.history) {
+        EXPECT_TRUE(r.refused) << r.iteration;
+        EXPECT_GE(m.params().find(r.refused_parameter), 0) << "'" << r.refused_parameter << "' is not a slice";
+    }
+    EXPECT_EQ(st.skipped_steps, 3);
+    EXPECT_EQ(m.params().raw(), raw_before);
+}

@@ -232,6 +232,17 @@ TEST(Adam, NonFiniteGradientLeavesEverythingUntouched) {
     EXPECT_THROW(adam.step(p.data(), g.data(), 3, 0.1f), std::invalid_argument);
 }
 
+// A finite gradient whose square overflows would leave v infinite (and the parameter frozen) for
+// good: refused like a NaN.
+TEST(Adam, OverflowingGradientIsRefused) {
+    std::vector<float> p = {1.0f, 2.0f}, g = {1e30f, 0.5f};
+    Adam adam(2);
+    EXPECT_EQ(adam.step(p.data(), g.data(), 2, 0.1f), 1u);
+    EXPECT_EQ(p[0], 1.0f);
+    EXPECT_EQ(adam.state().step, 0);
+    for (float v : adam.state().v) EXPECT_TRUE(std::isfinite(v));
+}
+
 TEST(AdamState, SerialisationRoundTripIsExact) {
     std::vector<float> p = {1.0f, -2.0f, 3.0f}, g = {0.3f, 1e-4f, -7.0f};
     Adam adam(3);

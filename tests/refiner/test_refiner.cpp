@@ -9,6 +9,7 @@
 #include "vae/lpips.h"
 #include "vae/vae.h"
 #include <gtest/gtest.h>
+#include <limits>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -92,6 +93,32 @@ TEST(Refiner, TrainingLowersTheLossAndKeepsTheBest) {
     EXPECT_LT(after, 0.25 * before) << "before " << before << " after " << after;
     EXPECT_LT(res.history.back().smoothed, res.history.front().loss);
     EXPECT_GT(res.history.front().dssim, 0.0);
+}
+
+// A non-finite loss (injected: a NaN in the target) refuses the step instead of aborting the run;
+// the weights stay as they were, and the steps after it still train.
+TEST(Refiner, NonFiniteStepsAreRefusedAndTheWeightsKept) {
+    Problem p = make_problem(12, 12);
+    auto r = Refiner::create(small(), 2);
+    const std::vector<float> identity = r->refine(p.in);
+    RefinerTrainOptions o;
+    o.iterations = 4;
+    o.crop = 0;
+    o.w_lpips = 0.f;
+    o.patience = 0;
+    std::vector<float> poisoned = p.target;
+    poisoned[5] = std::numeric_limits<float>::quiet_NaN();
+    const RefinerTrainResult bad = r->train(p.in, poisoned, nullptr, nullptr, nullptr, o);
+    ASSERT_EQ(bad.history.size(), 4u);
+    for (const RefinerRecord& rec : bad.history) {
+        EXPECT_TRUE(rec.refused);
+        EXPECT_EQ(rec.refused_parameter, "loss");
+        EXPECT_TRUE(std::isfinite(rec.smoothed));
+    }
+    EXPECT_EQ(r->refine(p.in), identity) << "a refused step changed the weights";
+    const RefinerTrainResult good = r->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    EXPECT_FALSE(good.history.back().refused);
+    EXPECT_NE(r->refine(p.in), identity);
 }
 
 TEST(Refiner, SaveLoadAndResumeReproduceOutputs) {
