@@ -40,6 +40,7 @@ struct RenderArgs {
     bool reference = false;  ///< also path trace + encode each edited frame, write metrics.csv
     int ref_spp = 256;
     std::string reference_cache;  ///< folder keeping path-traced reference frames for reuse
+    std::string frames;           ///< with edit: "A:B", only frames A..B (inclusive)
 };
 int run_render(const RenderArgs& args);
 int run_render_edit(const RenderArgs& args);

@@ -121,6 +121,9 @@ struct Cli {
         render->add_option("--reference-cache", r.reference_cache,
                            "with --reference: keep path-traced frames in this folder and reuse them "
                            "(keyed by edits file name, size, spp, tone and frame)");
+        render->add_option("--frames", r.frames,
+                           "with --edit: only frames A:B (inclusive, from 0); split jobs give the same frame files "
+                           "as one, and write metrics_A-B.csv");
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
         render->add_option("--spp", r.spp, "samples per pixel (default and 0: the scene's)")->check(non_negative());
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");

@@ -2,9 +2,25 @@
 // camera / light / object edits, frame by frame (pipeline::render_edits).
 #include "apps/commands.h"
 #include "pipeline/edit.h"
+#include <cstdio>
 #include <iostream>
+#include <stdexcept>
 
 namespace lpt::app {
+
+namespace {
+
+/// "A:B" with 0 <= A <= B.
+void parse_frames(const std::string& s, int& first, int& last) {
+    char colon = 0;
+    int a = -1, b = -1;
+    if (std::sscanf(s.c_str(), "%d%c%d", &a, &colon, &b) != 3 || colon != ':' || a < 0 || b < a)
+        throw std::invalid_argument("--frames expects A:B with 0 <= A <= B, got '" + s + "'");
+    first = a;
+    last = b;
+}
+
+}  // namespace
 
 int run_render_edit(const RenderArgs& a) {
     pipeline::EditJob job;
@@ -18,6 +34,7 @@ int run_render_edit(const RenderArgs& a) {
     job.reference = a.reference;
     job.ref_spp = a.ref_spp;
     job.reference_cache = a.reference_cache;
+    if (!a.frames.empty()) parse_frames(a.frames, job.first_frame, job.last_frame);
     const int frames = pipeline::render_edits(job, console_reporter(a.quiet));
     if (!a.quiet) std::cerr << "wrote " << frames << " frames to " << job.out << "\n";
     return 0;

@@ -70,6 +70,9 @@ void write_exr(const std::string& path, const Image& img) {
         for (int c = 0; c < img.channels; ++c) spec.channelnames.push_back((c < 10 ? "C0" : "C") + std::to_string(c));
     }
     spec.attribute("compression", "zip");
+    // No write time in the header (OpenEXR's writer adds one unless told otherwise): the same
+    // pixels give the same file, so split jobs merge into exactly the files of one job.
+    spec.attribute("DateTime", "");
     write_oiio(path, spec, img.data.data());
 }
 

@@ -174,20 +174,27 @@ int render_edits(const EditJob& job, const Reporter& report) {
     std::ostringstream csv;
     csv << metrics_header(tools.refiner != nullptr) << "\n";
     const auto start = std::chrono::steady_clock::now();
-    for (int i = 0; i < edits.frames; ++i) {
+    const int first = job.first_frame, last = job.last_frame < 0 ? edits.frames - 1 : job.last_frame;
+    if (first < 0 || first > last || last >= edits.frames)
+        throw std::invalid_argument(job.edits + ": frames " + std::to_string(first) + ":" + std::to_string(last) +
+                                    " are not within the sequence's 0:" + std::to_string(edits.frames - 1));
+    for (int i = first; i <= last; ++i) {
         const float t = float(i) / float(edits.frames);
         apply_edits(edits, t, original, original_camera, scene);
         const std::string row = render_frame(job, fit, tools, i, t, w, h, out);
         if (job.reference) csv << row << "\n";
         StageProgress p;
         p.stage = "edit";
-        p.step = i + 1;
-        p.total = edits.frames;
+        p.step = i - first + 1;
+        p.total = last - first + 1;
         p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!report.step(p)) throw Cancelled("edit");
     }
-    if (job.reference) write_text_atomic((out / "metrics.csv").string(), csv.str());
-    return edits.frames;
+    const bool whole = first == 0 && last == edits.frames - 1;
+    const std::string metrics =
+        whole ? "metrics.csv" : "metrics_" + std::to_string(first) + "-" + std::to_string(last) + ".csv";
+    if (job.reference) write_text_atomic((out / metrics).string(), csv.str());
+    return last - first + 1;
 }
 
 }  // namespace lpt::pipeline

@@ -20,9 +20,14 @@ struct EditJob {
     bool reference = false;
     int ref_spp = 256;
     std::string reference_cache;  ///< keeps path-traced reference frames for reuse
+    /// Only frames first_frame..last_frame (inclusive; -1 = the last): a sequence split into jobs
+    /// gives the same frame files as one job, since frame i depends on i alone (seed + i). A
+    /// split job writes its metrics rows to metrics_<first>-<last>.csv, so jobs never share a file.
+    int first_frame = 0, last_frame = -1;
 };
 
-/// Returns the number of frames written. Throws Cancelled when the reporter cancels.
+/// Returns the number of frames written. Throws Cancelled when the reporter cancels, and
+/// std::invalid_argument for a frame range outside the sequence.
 int render_edits(const EditJob& job, const Reporter& report = {});
 
 }  // namespace lpt::pipeline

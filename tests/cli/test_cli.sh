@@ -38,6 +38,15 @@ check test "$(wc -l < "$out/fit/loss.csv")" -eq 31
 check test "$(wc -l < "$out/fit/refiner_loss.csv")" -eq 7
 expect_error "latent.exr" "$bin" refine "$out" -q
 
+# An edit sequence split into frame ranges gives byte-identical files to one job (issue 20).
+edits="$src/scenes/cornell-box/edits-demo.json"
+"$bin" render "$out/fit" --edit "$edits" --spp 2 -q --out "$out/edit_all"
+"$bin" render "$out/fit" --edit "$edits" --spp 2 -q --frames 0:2 --out "$out/edit_split"
+"$bin" render "$out/fit" --edit "$edits" --spp 2 -q --frames 3:7 --out "$out/edit_split"
+check diff -r "$out/edit_all" "$out/edit_split"
+expect_error "not within the sequence" "$bin" render "$out/fit" --edit "$edits" --frames 3:9 -q --out "$out/x"
+expect_error "A:B" "$bin" render "$out/fit" --edit "$edits" --frames 5 -q --out "$out/x"
+
 expect_error "channels" "$bin" fit "$scene" --target "$out/r.exr" -q --out "$out/bad"
 expect_error "does not exist" "$bin" render "$out/missing.json" -q --out "$out/x.exr"
 printf '{"camera": {"fov": 40}, "shapes": [ {"type": "obj", "filename": "nope.obj", "material": "m"} ], "materials": {"m": {"type": "diffuse"}}}' > "$out/s.json"
