@@ -4,6 +4,7 @@
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
 #include "pipeline/fit_folder.h"
+#include "pipeline/output_lock.h"
 #include "pipeline/reference.h"
 #include "pipeline/refiner_io.h"
 #include "vae/vae.h"
@@ -199,7 +200,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     FitOptions o = job.options;
     o.checkpoint_dir = (fs::path(job.out) / "checkpoint").string();
 
-    fs::create_directories(job.out);
+    const OutputLock lock(job.out);  // before anything is written there
     std::unique_ptr<Vae> vae;
     if (job.encode) vae = open_vae(job.vae);
     const Target target = !job.target.empty() ? load_target_exr(job.target)

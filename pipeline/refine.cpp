@@ -3,6 +3,7 @@
 #include "core/image_io.h"
 #include "latent/latent.h"
 #include "pipeline/fit_folder.h"
+#include "pipeline/output_lock.h"
 #include "pipeline/paths.h"
 #include "pipeline/refiner_io.h"
 #include "vae/lpips.h"
@@ -119,6 +120,9 @@ std::string refine_status(const RefinerRecord& r) {
 
 RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     const fs::path dir(job.fitdir);
+    if (!fs::is_directory(dir))
+        throw std::runtime_error(job.fitdir + ": not a folder (expected a fit folder made by latentpt fit)");
+    const OutputLock lock(job.fitdir);
     RefinerInput in = load_refiner_input((dir / "latent.exr").string(), (dir / "aov.exr").string());
     const Image target = read_fit_image((dir / "target.exr").string(), kLatentChannels, in.width, in.height);
     const Judges judges = open_judges(job, target, report);

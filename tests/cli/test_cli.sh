@@ -37,6 +37,16 @@ check test "$(wc -l < "$out/fit/loss.csv")" -eq 31
 "$bin" refine "$out/fit" --iterations 6 --expansion 1 -q --resume
 check test "$(wc -l < "$out/fit/refiner_loss.csv")" -eq 7
 expect_error "latent.exr" "$bin" refine "$out" -q
+# A fit folder in use by another process (here util-linux flock holds its lock) is refused at once.
+if command -v flock >/dev/null; then
+    mkdir -p "$out/busy"
+    flock "$out/busy/.latentpt.lock" sleep 5 &
+    holder=$!
+    sleep 0.5
+    expect_error "in use by another latentpt process" "$bin" fit "$scene" --synthetic-res 8x8 --iterations 2 -q --no-refiner --out "$out/busy"
+    expect_error "in use by another latentpt process" "$bin" refine "$out/busy" -q
+    kill $holder 2>/dev/null; wait $holder 2>/dev/null
+fi
 
 # An edit sequence split into frame ranges gives byte-identical files to one job (issue 20).
 edits="$src/scenes/cornell-box/edits-demo.json"
