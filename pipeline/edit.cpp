@@ -3,6 +3,7 @@
 #include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "core/scene_edit.h"
+#include "pipeline/edit_session.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/paths.h"
 #include "pipeline/reference.h"
@@ -124,21 +125,14 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
 /// (empty without job.reference).
 std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& t, int i, float time, int w, int h,
                          const fs::path& out) {
-    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
-    ro.width = w;
-    ro.height = h;
-    ro.spp = job.spp;
-    ro.seed = job.seed + uint64_t(i);
-    std::vector<float> latent = render_toned(*fit.model, ro, fit.tone), refined;
+    const FrameLatents f = edited_frame(fit, t.refiner.get(), w, h, job.spp, job.seed + uint64_t(i));
+    const std::vector<float>&latent = f.latent, &refined = f.refined;
     char name[64];
     std::snprintf(name, sizeof name, "frame_%04d", i);
     const std::string stem = (out / name).string();
     write_latent(stem + "_latent.exr", w, h, latent);
     if (t.refiner) {
-        // Same spp and seed as the latent: an identity edit reproduces the fit's refined latent.
-        const RefinerInput view = refiner_view(*fit.scene, latent, w, h, ro.spp, ro.seed);
-        write_refiner_aovs(stem + "_aov.exr", view);
-        refined = t.refiner->refine(view);
+        write_refiner_aovs(stem + "_aov.exr", f.view);
         write_latent(stem + "_refined.exr", w, h, refined);
     }
     if (t.vae) {

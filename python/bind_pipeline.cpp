@@ -2,6 +2,8 @@
 // progress callbacks (returning False cancels: latentpt.Cancelled is raised) and the VAE on arrays.
 #include "bindings.h"
 #include "pipeline/edit.h"
+#include "pipeline/edit_session.h"
+#include "pipeline/fit_folder.h"
 #include "pipeline/fit.h"
 #include "pipeline/refine.h"
 #include "pipeline/vae_source.h"
@@ -137,6 +139,19 @@ py::array_t<float> decode(const PyVae& v, const py::array_t<float, py::array::c_
     return to_numpy(std::move(out), {h * f, w * f, 3});
 }
 
+py::dict edited_frame(pipeline::EditSession& s, int i, int spp, uint64_t seed, int width, int height) {
+    pipeline::FrameLatents f;
+    {
+        py::gil_scoped_release unlocked;
+        f = s.frame(i, spp, seed, width, height);
+    }
+    py::dict d;
+    d["latent"] = to_numpy(std::move(f.latent), {f.height, f.width, 16});
+    d["refined"] = f.refined.empty() ? py::object(py::none())
+                                     : py::object(to_numpy(std::move(f.refined), {f.height, f.width, 16}));
+    return d;
+}
+
 }  // namespace
 
 void bind_pipeline(py::module_& m) {
@@ -157,8 +172,23 @@ void bind_pipeline(py::module_& m) {
                  return PyVae{std::shared_ptr<Vae>(pipeline::open_vae({dir, "", "", ""}))};
              }),
              py::arg("dir") = "")
+        .def_static(
+            "from_fit",
+            [](const std::string& fitdir) {
+                return PyVae{std::shared_ptr<Vae>(pipeline::open_vae(pipeline::manifest_vae(fitdir + "/fit.json")))};
+            },
+            py::arg("fitdir"), "The VAE a fit folder was fitted with (its fit.json).")
         .def("encode", &encode, py::arg("rgb"), "Display RGB in [0, 1], (H, W, 3) -> latent (H/8, W/8, 16).")
         .def("decode", &decode, py::arg("latent"), "Latent (h, w, 16) -> display RGB (8h, 8w, 3).");
+    py::class_<pipeline::EditSession>(m, "EditSession",
+                                      "A fit's edit sequence (the JSON of render --edit), frame by frame as arrays.")
+        .def(py::init<const std::string&, const std::string&, const std::map<std::string, std::string>&>(),
+             py::arg("fitdir"), py::arg("edits"), py::arg("defines") = std::map<std::string, std::string>{})
+        .def_property_readonly("frames", &pipeline::EditSession::frames)
+        .def_property_readonly("has_refiner", &pipeline::EditSession::has_refiner)
+        .def("frame", &edited_frame, py::arg("i"), py::arg("spp") = 64, py::arg("seed") = 0, py::arg("width") = 0,
+             py::arg("height") = 0,
+             "Frame i as render --edit makes it: {'latent': (h, w, 16), 'refined': (h, w, 16) or None}.");
 }
 
 }  // namespace lpt::python

@@ -9,7 +9,7 @@
 latentpt.torch.render_latent makes the latent render a torch autograd function whose backward is the
 path-replay adjoint. docs/python.md.
 """
-from ._latentpt import (Cancelled, LatentScene, Scene, SceneError, Vae, fit, refine,  # noqa: F401
-                        render_edits)
+from ._latentpt import (Cancelled, EditSession, LatentScene, Scene, SceneError, Vae, fit,  # noqa: F401
+                        refine, render_edits)
 
-__all__ = ["Cancelled", "LatentScene", "Scene", "SceneError", "Vae", "fit", "refine", "render_edits"]
+__all__ = ["Cancelled", "EditSession", "LatentScene", "Scene", "SceneError", "Vae", "fit", "refine", "render_edits"]

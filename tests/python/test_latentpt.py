@@ -171,6 +171,17 @@ class PipelineTest(unittest.TestCase):
                 latentpt.fit(BOX, cancelled, progress=lambda p: p["step"] < 5, note=lambda t: None,
                              synthetic_res="8x8", iterations=12, spp=2, refiner=False)
             self.assertFalse(os.path.exists(os.path.join(cancelled, "params.json")))
+            session = latentpt.EditSession(os.path.join(d, "fit"), os.path.join(SRC, "scenes", "cornell-box", "edits-demo.json"))
+            self.assertEqual(session.frames, 8)
+            frame = session.frame(3, spp=2)
+            self.assertEqual(frame["latent"].shape, (8, 8, 16))
+            self.assertIsNone(frame["refined"])  # this fit ran without a refiner
+            self.assertFalse(np.array_equal(frame["latent"], session.frame(0, spp=2)["latent"]))
+            shared = os.environ.get("LATENTPT_SHARED", os.path.join(SRC, "..", "shared"))
+            if os.path.exists(os.path.join(shared, "models", "taesd3", "taesd3_decoder.safetensors")):
+                rgb = latentpt.Vae.from_fit(os.path.join(d, "fit")).decode(frame["latent"])
+                self.assertEqual(rgb.shape, (64, 64, 3))
+                self.assertTrue(np.isfinite(rgb).all())
             with self.assertRaises(TypeError):
                 latentpt.fit(BOX, cancelled, no_such_option=1)
 

@@ -1,0 +1,46 @@
+#include "pipeline/edit_session.h"
+#include "autodiff/fit.h"
+#include "pipeline/refiner_io.h"
+#include <filesystem>
+#include <stdexcept>
+
+namespace lpt::pipeline {
+
+namespace fs = std::filesystem;
+
+FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int width, int height, int spp, uint64_t seed) {
+    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
+    ro.width = width;
+    ro.height = height;
+    ro.spp = spp;
+    ro.seed = seed;
+    FrameLatents f;
+    f.width = width;
+    f.height = height;
+    f.latent = render_toned(*fit.model, ro, fit.tone);
+    if (refiner) {
+        // Same spp and seed as the latent: an identity edit reproduces the fit's refined latent.
+        f.view = refiner_view(*fit.scene, f.latent, width, height, ro.spp, ro.seed);
+        f.refined = refiner->refine(f.view);
+    }
+    return f;
+}
+
+EditSession::EditSession(const std::string& fitdir, const std::string& edits,
+                         const std::map<std::string, std::string>& defines)
+    : m_fit(load_fit_folder(fitdir, defines)), m_edits(load_edits(edits, *m_fit.scene)), m_camera(m_fit.scene->camera) {
+    const fs::path pt = fs::path(fitdir) / "refiner.pt";
+    if (fs::exists(pt)) m_refiner = Refiner::load(pt.string());
+    for (const Shape& s : m_fit.scene->shapes) m_original.push_back(s.mesh);
+}
+
+FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int height) {
+    if (i < 0 || i >= m_edits.frames)
+        throw std::invalid_argument("frame " + std::to_string(i) +
+                                    " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
+    apply_edits(m_edits, float(i) / float(m_edits.frames), m_original, m_camera, *m_fit.scene);
+    return edited_frame(m_fit, m_refiner.get(), width > 0 ? width : m_fit.latent_width,
+                        height > 0 ? height : m_fit.latent_height, spp, seed + uint64_t(i));
+}
+
+}  // namespace lpt::pipeline
