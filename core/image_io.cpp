@@ -1,4 +1,5 @@
 #include "core/image_io.h"
+#include "core/film.h"
 #include "core/error.h"
 #include <sstream>
 #include <OpenImageIO/imageio.h>
@@ -108,6 +109,12 @@ Image read_image(const std::string& path) {
     img.height = spec.height;
     img.channels = spec.nchannels;
     img.channel_names = spec.channelnames;
+    // The header's size is checked before anything is allocated from it.
+    try {
+        check_image_fits(img.width, img.height, size_t(std::max(img.channels, 1)));
+    } catch (const std::length_error& e) {
+        throw std::runtime_error(path + ": " + e.what());
+    }
     img.data.resize(size_t(img.width) * img.height * img.channels);
     if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.data.data()))
         throw std::runtime_error(path + ": cannot decode image: " + in->geterror());

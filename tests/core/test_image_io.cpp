@@ -24,3 +24,39 @@ TEST(ImageIo, SixteenChannelExrKeepsChannelOrder) {
     for (const auto& e : std::filesystem::directory_iterator(dir))
         EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
+
+namespace {
+
+uint32_t crc32(const std::string& bytes) {
+    uint32_t c = 0xffffffffu;
+    for (unsigned char b : bytes) {
+        c ^= b;
+        for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return ~c;
+}
+
+std::string be32(uint32_t v) { return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; }
+
+std::string png_chunk(const std::string& type, const std::string& data) {
+    return be32(uint32_t(data.size())) + type + data + be32(crc32(type + data));
+}
+
+}  // namespace
+
+// A header that claims 200000 x 200000 pixels in a 60-byte file: refused with the size it would
+// need before anything is allocated (it used to end in std::bad_alloc).
+TEST(ImageIo, HugeHeaderIsRefusedBeforeAllocating) {
+    const std::string ihdr = be32(200000) + be32(200000) + std::string("\x08\x02\x00\x00\x00", 5);  // 8-bit RGB
+    const std::string png =
+        std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + png_chunk("IDAT", "") + png_chunk("IEND", "");
+    const std::string path = test::write_temp_file("huge.png", png);
+    try {
+        read_image(path);
+        FAIL() << "a 200000 x 200000 header must be refused";
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("huge.png"), std::string::npos) << what;
+        EXPECT_NE(what.find("GiB"), std::string::npos) << what;
+    }
+}
