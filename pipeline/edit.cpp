@@ -2,13 +2,11 @@
 #include "autodiff/fit.h"
 #include "autodiff/loss.h"
 #include "core/image_io.h"
-#include "core/scene_edit.h"
 #include "pipeline/edit_session.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/paths.h"
 #include "pipeline/reference.h"
 #include "pipeline/refiner_io.h"
-#include "refiner/refiner.h"
 #include "vae/lpips.h"
 #include "vae/ssim.h"
 #include "vae/vae.h"
@@ -27,15 +25,14 @@ namespace {
 
 const char* const kMetricColumns = "latent_mse,latent_psnr,latent_dssim,rgb_mse_x100,rgb_ssim,rgb_lpips";
 
-/// What the frames are refined, decoded and judged with; each is optional.
+/// What the frames are decoded and judged with; each is optional (the refiner is the session's).
 struct Tools {
-    std::unique_ptr<Refiner> refiner;
     std::unique_ptr<Vae> vae;
     std::unique_ptr<Lpips> lpips;
 };
 
-Tools open_tools(const EditJob& job, const FitFolder& fit, const Reporter& report) {
-    const fs::path dir(job.fitdir);
+Tools open_tools(const EditJob& job, const EditSession& session, const Reporter& report) {
+    const FitFolder& fit = session.fit();
     const bool have_vae = vae_present(fit.vae);
     if (job.reference && !have_vae)
         throw std::runtime_error("--reference needs the fit's VAE to encode references; not found: " +
@@ -44,8 +41,8 @@ Tools open_tools(const EditJob& job, const FitFolder& fit, const Reporter& repor
         report.say("note: the fit's VAE is not here (" + default_vae_dir(fit.vae.dir) + "): writing latents only");
     Tools t;
     // Stage 2, when the fit trained one: every frame is refined from its latent and AOVs.
-    if (fs::exists(dir / "refiner.pt")) t.refiner = Refiner::load((dir / "refiner.pt").string());
-    else report.say("note: " + (dir / "refiner.pt").string() + " not found: frames are not refined");
+    if (!session.has_refiner())
+        report.say("note: " + (fs::path(job.fitdir) / "refiner.pt").string() + " not found: frames are not refined");
     if (have_vae) t.vae = open_vae(fit.vae);
     if (job.reference && have_vae) {
         const std::string lpips_dir = default_lpips_dir("");
@@ -121,32 +118,32 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
     return ref;
 }
 
-/// Renders, refines and decodes frame `i` (the scene already edited); returns its metrics row
-/// (empty without job.reference).
-std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& t, int i, float time, int w, int h,
+/// Renders, refines and decodes frame `i`; returns its metrics row (empty without job.reference).
+std::string render_frame(const EditJob& job, EditSession& session, const Tools& t, int i, int w, int h,
                          const fs::path& out) {
-    const FrameLatents f = edited_frame(fit, t.refiner.get(), w, h, job.spp, job.seed + uint64_t(i));
+    const FrameLatents f = session.frame(i, job.spp, job.seed, w, h);
+    const bool refiner = session.has_refiner();
     const std::vector<float>&latent = f.latent, &refined = f.refined;
     char name[64];
     std::snprintf(name, sizeof name, "frame_%04d", i);
     const std::string stem = (out / name).string();
     write_latent(stem + "_latent.exr", w, h, latent);
-    if (t.refiner) {
+    if (refiner) {
         write_refiner_aovs(stem + "_aov.exr", f.view);
         write_latent(stem + "_refined.exr", w, h, refined);
     }
     if (t.vae) {
         // frame_NNNN.png is the result (refined when there is a refiner); _rendered.png the unrefined one.
-        write_png_display(stem + (t.refiner ? "_rendered.png" : ".png"),
+        write_png_display(stem + (refiner ? "_rendered.png" : ".png"),
                           Image{8 * w, 8 * h, 3, t.vae->decode(latent, w, h), {}});
-        if (t.refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, t.vae->decode(refined, w, h), {}});
+        if (refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, t.vae->decode(refined, w, h), {}});
     }
     if (!job.reference) return {};
     std::vector<float> ref_rgb;
-    const std::vector<float> ref = frame_reference(job, fit, t, name, stem, w, h, ref_rgb);
+    const std::vector<float> ref = frame_reference(job, session.fit(), t, name, stem, w, h, ref_rgb);
     std::ostringstream row;
-    row << i << "," << time << frame_metrics(latent, ref, ref_rgb, w, h, t);
-    if (t.refiner) row << frame_metrics(refined, ref, ref_rgb, w, h, t);
+    row << i << "," << session.time(i) << frame_metrics(latent, ref, ref_rgb, w, h, t);
+    if (refiner) row << frame_metrics(refined, ref, ref_rgb, w, h, t);
     return row.str();
 }
 
@@ -155,27 +152,22 @@ std::string render_frame(const EditJob& job, const FitFolder& fit, const Tools& 
 int render_edits(const EditJob& job, const Reporter& report) {
     if (!fs::is_directory(job.fitdir))
         throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
-    FitFolder fit = load_fit_folder(job.fitdir, job.defines);
-    Scene& scene = *fit.scene;
-    const int w = job.width > 0 ? job.width : fit.latent_width, h = job.height > 0 ? job.height : fit.latent_height;
-    const EditSequence edits = load_edits(job.edits, scene);
-    std::vector<TriangleMesh> original;
-    for (const Shape& s : scene.shapes) original.push_back(s.mesh);
-    const Camera original_camera = scene.camera;
-    const Tools tools = open_tools(job, fit, report);
+    EditSession session(job.fitdir, job.edits, job.defines);
+    const int w = job.width > 0 ? job.width : session.latent_width();
+    const int h = job.height > 0 ? job.height : session.latent_height();
+    const Tools tools = open_tools(job, session, report);
     const fs::path out(job.out);
     fs::create_directories(out);
     std::ostringstream csv;
-    csv << metrics_header(tools.refiner != nullptr) << "\n";
+    csv << metrics_header(session.has_refiner()) << "\n";
     const auto start = std::chrono::steady_clock::now();
-    const int first = job.first_frame, last = job.last_frame < 0 ? edits.frames - 1 : job.last_frame;
-    if (first < 0 || first > last || last >= edits.frames)
+    const int frames = session.frames();
+    const int first = job.first_frame, last = job.last_frame < 0 ? frames - 1 : job.last_frame;
+    if (first < 0 || first > last || last >= frames)
         throw std::invalid_argument(job.edits + ": frames " + std::to_string(first) + ":" + std::to_string(last) +
-                                    " are not within the sequence's 0:" + std::to_string(edits.frames - 1));
+                                    " are not within the sequence's 0:" + std::to_string(frames - 1));
     for (int i = first; i <= last; ++i) {
-        const float t = float(i) / float(edits.frames);
-        apply_edits(edits, t, original, original_camera, scene);
-        const std::string row = render_frame(job, fit, tools, i, t, w, h, out);
+        const std::string row = render_frame(job, session, tools, i, w, h, out);
         if (job.reference) csv << row << "\n";
         StageProgress p;
         p.stage = "edit";
@@ -184,7 +176,7 @@ int render_edits(const EditJob& job, const Reporter& report) {
         p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!report.step(p)) throw Cancelled("edit");
     }
-    const bool whole = first == 0 && last == edits.frames - 1;
+    const bool whole = first == 0 && last == frames - 1;
     const std::string metrics =
         whole ? "metrics.csv" : "metrics_" + std::to_string(first) + "-" + std::to_string(last) + ".csv";
     if (job.reference) write_text_atomic((out / metrics).string(), csv.str());

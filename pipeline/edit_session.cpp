@@ -8,6 +8,9 @@ namespace lpt::pipeline {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// The already edited scene of `fit` at spp with seed, refined when `refiner` is given.
 FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int width, int height, int spp, uint64_t seed) {
     RenderOptions ro = RenderOptions::from_scene(*fit.scene);
     ro.width = width;
@@ -26,6 +29,8 @@ FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int widt
     return f;
 }
 
+}  // namespace
+
 EditSession::EditSession(const std::string& fitdir, const std::string& edits,
                          const std::map<std::string, std::string>& defines)
     : m_fit(load_fit_folder(fitdir, defines)), m_edits(load_edits(edits, *m_fit.scene)), m_camera(m_fit.scene->camera) {
@@ -38,7 +43,7 @@ FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int he
     if (i < 0 || i >= m_edits.frames)
         throw std::invalid_argument("frame " + std::to_string(i) +
                                     " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
-    apply_edits(m_edits, float(i) / float(m_edits.frames), m_original, m_camera, *m_fit.scene);
+    apply_edits(m_edits, time(i), m_original, m_camera, *m_fit.scene);
     return edited_frame(m_fit, m_refiner.get(), width > 0 ? width : m_fit.latent_width,
                         height > 0 ? height : m_fit.latent_height, spp, seed + uint64_t(i));
 }

@@ -20,10 +20,6 @@ struct FrameLatents {
     RefinerInput view;           ///< the refiner's input (latent + AOVs); empty without a refiner
 };
 
-/// Frame `i` of the already edited scene of `fit`, rendered at spp with seed (render --edit uses
-/// seed + i), refined when `refiner` is given.
-FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int width, int height, int spp, uint64_t seed);
-
 class EditSession {
 public:
     /// Loads the fit folder (defines override its -D values), its refiner when it has one, and
@@ -34,8 +30,13 @@ public:
     bool has_refiner() const { return m_refiner != nullptr; }
     int latent_width() const { return m_fit.latent_width; }
     int latent_height() const { return m_fit.latent_height; }
-    /// Frame i as `render --edit --seed seed` renders it (0 = the fit's latent resolution).
+    /// The edit parameter t in [0, 1) of frame i.
+    float time(int i) const { return float(i) / float(m_edits.frames); }
+    /// Frame i as `render --edit --seed seed` renders it (0 = the fit's latent resolution): the
+    /// scene is edited to time(i) and rendered with seed + i, so a frame depends on i alone.
     FrameLatents frame(int i, int spp = 64, uint64_t seed = 0, int width = 0, int height = 0);
+    /// The fit, its scene as the last frame() left it (for path-traced references of that frame).
+    const FitFolder& fit() const { return m_fit; }
 
 private:
     FitFolder m_fit;
