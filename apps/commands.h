@@ -5,6 +5,7 @@
 #include "pipeline/paths.h"
 #include "pipeline/progress.h"
 #include "pipeline/refine.h"
+#include "pipeline/resolution.h"
 #include "pipeline/vae_source.h"
 #include <cstdint>
 #include <map>
@@ -20,6 +21,7 @@ namespace lpt::app {
 
 using pipeline::default_lpips_dir;
 using pipeline::default_vae_dir;
+using pipeline::parse_resolution;
 using pipeline::shared_dir;
 using pipeline::VaeSource;
 
@@ -111,9 +113,6 @@ struct CompareArgs {
     bool strict = false;  ///< exit 3 when the verdict fails
 };
 int run_compare(const CompareArgs& a);
-
-/// Parses "WxH"; throws std::invalid_argument with a clear message.
-void parse_resolution(const std::string& s, int& w, int& h);
 
 /// A pipeline reporter for the terminal: progress and notes on stderr (nothing when quiet, except
 /// warnings).

@@ -73,15 +73,6 @@ pipeline::Reporter console_reporter(bool quiet) {
     return r;
 }
 
-void parse_resolution(const std::string& s, int& w, int& h) {
-    char x = 0;
-    int a = 0, b = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d", &a, &x, &b) != 3 || (x != 'x' && x != 'X') || a < 1 || b < 1)
-        throw std::invalid_argument("--res expects WxH with positive integers, got '" + s + "'");
-    w = a;
-    h = b;
-}
-
 Progress::Progress(std::string label, bool enabled) : m_label(std::move(label)), m_enabled(enabled), m_start(now()) {}
 
 void Progress::update(double fraction, uint64_t rays) {

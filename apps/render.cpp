@@ -24,7 +24,7 @@ int run_render(const RenderArgs& a) {
     opt.seed = a.seed;
     if (a.spp > 0) opt.spp = a.spp;
     if (a.max_depth != -2) opt.max_depth = a.max_depth;
-    if (!a.res.empty()) parse_resolution(a.res, opt.width, opt.height);
+    if (!a.res.empty()) parse_resolution(a.res, opt.width, opt.height, "--res");
     opt.strategy = a.strategy == "nee"    ? LightStrategy::Nee
                    : a.strategy == "bsdf" ? LightStrategy::Bsdf
                                           : LightStrategy::Mis;
@@ -43,7 +43,7 @@ int run_render(const RenderArgs& a) {
     write_png_srgb(with_suffix(a.out, ".png"), img, a.exposure);
     if (a.aov) {
         int aw = img.width, ah = img.height;
-        if (!a.aov_res.empty()) parse_resolution(a.aov_res, aw, ah);
+        if (!a.aov_res.empty()) parse_resolution(a.aov_res, aw, ah, "--aov-res");
         AovImages aov = render_aovs(scene, spectra, aw, ah, std::min(opt.spp, 16), a.seed, opt.sampler);
         write_exr(with_suffix(a.out, ".normal.exr"), Image{aov.width, aov.height, 3, aov.normal, {"X", "Y", "Z"}});
         write_exr(with_suffix(a.out, ".distance.exr"), Image{aov.width, aov.height, 1, aov.distance, {"Z"}});

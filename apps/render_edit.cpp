@@ -28,7 +28,8 @@ int run_render_edit(const RenderArgs& a) {
     job.edits = a.edit;
     job.out = a.out.empty() || a.out == "render.exr" ? "edit-out" : a.out;
     job.defines = a.defines;
-    if (!a.res.empty()) parse_resolution(a.res, job.width, job.height);  // latent resolution may differ from training
+    if (!a.res.empty())
+        parse_resolution(a.res, job.width, job.height, "--res");  // latent resolution may differ from training
     if (a.spp > 0) job.spp = a.spp;
     job.seed = a.seed;
     job.reference = a.reference;

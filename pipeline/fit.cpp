@@ -7,6 +7,7 @@
 #include "pipeline/output_lock.h"
 #include "pipeline/reference.h"
 #include "pipeline/refiner_io.h"
+#include "pipeline/resolution.h"
 #include "vae/vae.h"
 #include <algorithm>
 #include <cmath>
@@ -26,15 +27,6 @@ struct Target {
     int width = 0, height = 0;  ///< latent resolution
 };
 
-void parse_dimension(const std::string& s, int& w, int& h) {
-    char x = 0;
-    int a = 0, b = 0;
-    if (std::sscanf(s.c_str(), "%d%c%d", &a, &x, &b) != 3 || (x != 'x' && x != 'X') || a < 1 || b < 1)
-        throw std::invalid_argument("expected a resolution WxH with positive integers, got '" + s + "'");
-    w = a;
-    h = b;
-}
-
 Target load_target_exr(const std::string& path) {
     Image img = read_image(path);
     if (img.channels != kLatentChannels)
@@ -53,7 +45,7 @@ Target load_target_exr(const std::string& path) {
 /// reference_rgb.exr: the refiner's LPIPS and metrics.json compare decoded latents with it.
 Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, const Reporter& report) {
     int iw = 0, ih = 0;
-    parse_dimension(job.encode_res, iw, ih);
+    parse_resolution(job.encode_res, iw, ih, "--encode-res");
     const fs::path out(job.out);
     std::vector<float> ref_rgb;
     Target t;
@@ -69,7 +61,7 @@ Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, con
 /// a VAE, and the test suite's convergence check.
 Target synthetic_target(const FitJob& job, const Scene& scene) {
     Target t;
-    parse_dimension(job.synthetic_res, t.width, t.height);
+    parse_resolution(job.synthetic_res, t.width, t.height, "--synthetic-res");
     LatentModel truth(scene, parameterisation_from_string(job.param), job.synthetic_seed);
     RenderOptions ro = RenderOptions::from_scene(scene);
     ro.width = t.width;
