@@ -14,9 +14,6 @@ class LatentStage {
 public:
     LatentStage(const LatentTerms<N>& terms, PathObserver<N>* observer) : m_terms(terms), m_obs(observer) {}
 
-    /// Ĩe is rendered (else transport stops at the first non-delta vertex).
-    bool emission() const { return m_terms.emission; }
-
     /// A path escaped: the background joins Ĩa unless a non-delta vertex came before.
     void escaped(PathState<N>& p, uint32_t slot) const {
         if (!m_terms.ambient || p.past_first[slot]) return;

@@ -18,17 +18,14 @@ nlohmann::json parse_json_file(const std::string& path) {
     }
 }
 
-void set_terms(LatentTerms<kLatentChannels>& t, const std::string& gate, const std::string& terms) {
+}  // namespace
+
+void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {
+    LatentTerms<kLatentChannels>& t = model.terms();
     t.gate = gate == "visible" ? OcclusionGate::Visible : OcclusionGate::Shadowed;
     t.emission = terms.find('e') != std::string::npos;
     t.ambient = terms.find('a') != std::string::npos;
     t.occlusion = terms.find('c') != std::string::npos;
-}
-
-}  // namespace
-
-void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {
-    set_terms(model.terms(), gate, terms);
 }
 
 FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::string, std::string>& overrides) {
