@@ -6,6 +6,22 @@
 
 namespace lpt {
 
+/// A library's message made one line: line breaks become "; " and trailing ones go, so every
+/// error stays one line that names the file first (libpng, tinygltf and OpenImageIO write several).
+inline std::string one_line(std::string s) {
+    while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
+    std::string out;
+    for (size_t i = 0; i < s.size(); ++i) {
+        if (s[i] != '\n' && s[i] != '\r') {
+            out += s[i];
+            continue;
+        }
+        while (i + 1 < s.size() && (s[i + 1] == '\n' || s[i + 1] == '\r')) ++i;
+        out += "; ";
+    }
+    return out;
+}
+
 class SceneError : public std::runtime_error {
 public:
     SceneError(const std::string& file, const std::string& field, const std::string& message, int line = -1)
@@ -28,7 +44,7 @@ private:
         std::string s = file;
         if (line >= 0) s += ":" + std::to_string(line);
         if (!field.empty()) s += ": field '" + field + "'";
-        return s + ": " + msg;
+        return s + ": " + one_line(msg);
     }
     std::string m_file, m_field, m_message;
     int m_line;

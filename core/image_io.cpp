@@ -1,12 +1,18 @@
 #include "core/image_io.h"
-#include "core/film.h"
 #include "core/error.h"
-#include <sstream>
-#include <OpenImageIO/imageio.h>
+#include "core/film.h"
+#include "core/image_reader.h"
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <png.h>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <unistd.h>
 
@@ -17,23 +23,37 @@ namespace fs = std::filesystem;
 namespace {
 std::string temp_path_for(const std::string& path) {
     fs::path p(path);
-    // Keep the extension last: OIIO chooses the format from it.
     return (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + p.extension().string()))
         .string();
 }
 
-void write_oiio(const std::string& path, const OIIO::ImageSpec& spec, const void* data) {
+/// Runs `write(tmp)` on a temporary file beside `path` and renames it over `path` once complete.
+template <typename Write>
+void write_atomically(const std::string& path, Write write) {
     if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
-    std::string tmp = temp_path_for(path);
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw std::runtime_error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
-    if (!out->open(tmp, spec) || !out->write_image(spec.format, data) || !out->close()) {
-        std::string err = out->geterror();
-        fs::remove(tmp);
-        throw std::runtime_error(path + ": cannot write image: " + err);
+    const std::string tmp = temp_path_for(path);
+    try {
+        write(tmp);
+    } catch (const std::exception& e) {
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        throw std::runtime_error(path + ": cannot write image: " + e.what());
     }
     fs::rename(tmp, path);
 }
+
+/// The names OpenImageIO gave channels when it wrote our EXRs (kept, so files stay the same):
+/// Y; R,G; R,G,B; R,G,B,A; beyond four C00..C{n-1}, zero-padded because EXR stores channels
+/// sorted by name and C10 would come before C2.
+std::vector<std::string> exr_channel_names(const Image& img) {
+    if (!img.channel_names.empty()) return img.channel_names;
+    if (img.channels == 1) return {"Y"};
+    std::vector<std::string> names;
+    for (int c = 0; c < img.channels; ++c)
+        names.push_back(img.channels <= 4 ? std::string(1, "RGBA"[c]) : (c < 10 ? "C0" : "C") + std::to_string(c));
+    return names;
+}
+
 /// EXR keeps channels in name order, so latent channels "C0".."C15" written by other tools come
 /// back as C0, C1, C10, ..., C15, C2, ...: put channels named C<number> in numeric order.
 void reorder_numbered_channels(Image& img) {
@@ -62,19 +82,29 @@ float linear_to_srgb(float v) {
 }
 
 void write_exr(const std::string& path, const Image& img) {
-    OIIO::ImageSpec spec(img.width, img.height, img.channels, OIIO::TypeDesc::FLOAT);
-    if (!img.channel_names.empty()) {
-        spec.channelnames = img.channel_names;
-    } else if (img.channels > 4) {
-        spec.channelnames.clear();
-        // Zero-padded: EXR stores channels sorted by name, and C10 would come before C2.
-        for (int c = 0; c < img.channels; ++c) spec.channelnames.push_back((c < 10 ? "C0" : "C") + std::to_string(c));
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext != ".exr")
+        throw std::invalid_argument(path + ": an OpenEXR file is written here; its name must end in .exr");
+    const std::vector<std::string> names = exr_channel_names(img);
+    if (int(names.size()) != img.channels || img.data.size() != size_t(img.width) * img.height * img.channels)
+        throw std::invalid_argument(path + ": image data does not match its size and channels");
+    // No write time in the header: the same pixels give the same file, so split jobs merge into
+    // exactly the files of one job.
+    Imf::Header header(img.width, img.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    Imf::FrameBuffer frame;
+    const size_t x_stride = sizeof(float) * img.channels, y_stride = x_stride * img.width;
+    for (int c = 0; c < img.channels; ++c) {
+        header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+        char* base = reinterpret_cast<char*>(const_cast<float*>(img.data.data() + c));
+        frame.insert(names[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
     }
-    spec.attribute("compression", "zip");
-    // No write time in the header (OpenEXR's writer adds one unless told otherwise): the same
-    // pixels give the same file, so split jobs merge into exactly the files of one job.
-    spec.attribute("DateTime", "");
-    write_oiio(path, spec, img.data.data());
+    write_atomically(path, [&](const std::string& tmp) {
+        Imf::OutputFile file(tmp.c_str(), header);
+        file.setFrameBuffer(frame);
+        file.writePixels(img.height);
+    });
 }
 
 namespace {
@@ -86,8 +116,18 @@ void write_png8(const std::string& path, const Image& img, Encode encode) {
             float v = img.data[i * img.channels + std::min(c, img.channels - 1)];
             px[i * 3 + c] = uint8_t(std::lround(255.f * encode(std::isfinite(v) ? v : 0.f)));
         }
-    OIIO::ImageSpec spec(img.width, img.height, 3, OIIO::TypeDesc::UINT8);
-    write_oiio(path, spec, px.data());
+    write_atomically(path, [&](const std::string& tmp) {
+        png_image png{};
+        png.version = PNG_IMAGE_VERSION;
+        png.width = png_uint_32(img.width);
+        png.height = png_uint_32(img.height);
+        png.format = PNG_FORMAT_RGB;
+        if (!png_image_write_to_file(&png, tmp.c_str(), 0, px.data(), 0, nullptr)) {
+            const std::string message = png.message;
+            png_image_free(&png);
+            throw std::runtime_error(message);
+        }
+    });
 }
 }  // namespace
 
@@ -101,14 +141,13 @@ void write_png_display(const std::string& path, const Image& img) {
 }
 
 Image read_image(const std::string& path) {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw std::runtime_error(path + ": cannot read image: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
+    std::unique_ptr<ImageFileReader> in = open_image_file(path);
+    const ImageFileInfo& info = in->info();
     Image img;
-    img.width = spec.width;
-    img.height = spec.height;
-    img.channels = spec.nchannels;
-    img.channel_names = spec.channelnames;
+    img.width = info.width;
+    img.height = info.height;
+    img.channels = info.channels;
+    img.channel_names = info.channel_names;
     // The header's size is checked before anything is allocated from it.
     try {
         check_image_fits(img.width, img.height, size_t(std::max(img.channels, 1)));
@@ -116,8 +155,7 @@ Image read_image(const std::string& path) {
         throw std::runtime_error(path + ": " + e.what());
     }
     img.data.resize(size_t(img.width) * img.height * img.channels);
-    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.data.data()))
-        throw std::runtime_error(path + ": cannot decode image: " + in->geterror());
+    in->read_float(img.data.data());
     reorder_numbered_channels(img);
     return img;
 }

@@ -1,4 +1,5 @@
-// Image files through OpenImageIO. Writes are atomic: the data goes to a temporary file in the
+// Image files: EXR written by OpenEXR, PNG by libpng, any format read through OpenImageIO (a
+// plugin opened on the first read, core/image_reader.h). Writes are atomic: the data goes to a temporary file in the
 // destination folder, which is renamed over the target only once complete, so an interrupted
 // run never leaves a truncated image.
 #pragma once
@@ -13,7 +14,8 @@ struct Image {
     std::vector<std::string> channel_names;
 };
 
-/// Float EXR (half=false: 32-bit). Channel names default to R,G,B(,A) or C0..C{n-1}.
+/// 32-bit float EXR, ZIP-compressed, no time stamp; `path` must end in .exr. Channel names
+/// default to Y / R,G / R,G,B / R,G,B,A, or C00..C{n-1} beyond four channels.
 void write_exr(const std::string& path, const Image& img);
 /// 8-bit sRGB PNG preview of the first 3 channels: linear values × 2^exposure, clamped, sRGB OETF.
 void write_png_srgb(const std::string& path, const Image& img, float exposure = 0.f);

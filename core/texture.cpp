@@ -1,10 +1,11 @@
-// Bitmap loading (OpenImageIO), the process-wide bitmap cache, lookups, and the Props glue.
+// Bitmap loading (OpenImageIO through core/image_reader.h), the process-wide bitmap cache, lookups, and the Props glue.
 // Lookups follow Dr.Jit's dr::Texture as used by Mitsuba 3's bitmap plugin: bilinear at
 // uv·size − 0.5 between the four surrounding pixel centres, nearest at floor(uv·size), each
 // pixel index wrapped on its own.
 #include "core/texture.h"
 #include "core/error.h"
-#include <OpenImageIO/imageio.h>
+#include "core/film.h"
+#include "core/image_reader.h"
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -22,44 +23,54 @@ namespace {
 /// The exact sRGB EOTF (IEC 61966-2-1), in double so the 8-bit table is correctly rounded.
 double srgb_to_linear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
+/// "<path>: message" -> "message" (SceneError puts the path in front again).
+std::string strip_path(const std::string& what, const std::string& path) {
+    return what.rfind(path + ": ", 0) == 0 ? what.substr(path.size() + 2) : what;
+}
+
 std::shared_ptr<const BitmapData> decode(const std::string& path, bool raw) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw SceneError(path, "", "cannot open image file (missing or not a file)");
-    // PNG/TIFF alpha is premultiplied into the colour by default in OIIO; Mitsuba drops alpha
-    // and keeps the colour as stored, so ask for unassociated alpha.
-    OIIO::ImageSpec config;
-    config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    if (!in) throw SceneError(path, "", "cannot read image: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    const int w = spec.width, h = spec.height, nc = spec.nchannels;
-    if (w <= 0 || h <= 0 || spec.depth > 1) throw SceneError(path, "", "image is empty or not 2D");
+    // Mitsuba drops alpha and keeps the colour as stored, so ask for unassociated alpha.
+    std::unique_ptr<ImageFileReader> in;
+    try {
+        in = open_image_file(path, true);
+    } catch (const std::runtime_error& e) {
+        throw SceneError(path, "", strip_path(e.what(), path));
+    }
+    const ImageFileInfo& info = in->info();
+    const int w = info.width, h = info.height, nc = info.channels;
+    if (w <= 0 || h <= 0 || info.depth > 1) throw SceneError(path, "", "image is empty or not 2D");
     if (nc < 1 || nc > 4)
         throw SceneError(path, "",
                          "image has " + std::to_string(nc) + " channels (expected 1 to 4: Y, YA, RGB or RGBA)");
-    const OIIO::TypeDesc::BASETYPE base = OIIO::TypeDesc::BASETYPE(spec.format.basetype);
-    const bool is_float =
-        base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
-    const bool srgb = !is_float && !raw;  // Mitsuba 3: JPEG/PNG data is sRGB, EXR/HDR linear
+    try {
+        check_image_fits(w, h, size_t(nc));
+    } catch (const std::length_error& e) {
+        throw SceneError(path, "", e.what());
+    }
+    const bool srgb = !info.is_float && !raw;  // Mitsuba 3: JPEG/PNG data is sRGB, EXR/HDR linear
 
     const size_t n = size_t(w) * size_t(h);
     std::vector<float> px(n * size_t(nc));
-    if (base == OIIO::TypeDesc::UINT8) {
-        // Exact per-code conversion: a 256-entry table instead of float rounding of v/255.
-        std::vector<uint8_t> bytes(px.size());
-        if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, bytes.data()))
-            throw SceneError(path, "", "cannot decode image (truncated or corrupt?): " + in->geterror());
-        std::array<float, 256> lut;
-        for (int i = 0; i < 256; ++i) lut[i] = float(srgb ? srgb_to_linear(i / 255.0) : i / 255.0);
-        for (size_t i = 0; i < px.size(); ++i) px[i] = lut[bytes[i]];
-    } else {
-        // Other integer types come back normalised to [0, 1]; floats as stored.
-        if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, px.data()))
-            throw SceneError(path, "", "cannot decode image (truncated or corrupt?): " + in->geterror());
-        if (srgb)
-            for (float& v : px) v = float(srgb_to_linear(v));
+    try {
+        if (info.is_uint8) {
+            // Exact per-code conversion: a 256-entry table instead of float rounding of v/255.
+            std::vector<uint8_t> bytes(px.size());
+            in->read_uint8(bytes.data());
+            std::array<float, 256> lut;
+            for (int i = 0; i < 256; ++i) lut[i] = float(srgb ? srgb_to_linear(i / 255.0) : i / 255.0);
+            for (size_t i = 0; i < px.size(); ++i) px[i] = lut[bytes[i]];
+        } else {
+            // Other integer types come back normalised to [0, 1]; floats as stored.
+            in->read_float(px.data());
+            if (srgb)
+                for (float& v : px) v = float(srgb_to_linear(v));
+        }
+    } catch (const std::runtime_error& e) {
+        throw SceneError(path, "", strip_path(e.what(), path));
     }
-    in->close();
+    in.reset();
 
     auto out = std::make_shared<BitmapData>();
     out->path = path;

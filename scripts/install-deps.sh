@@ -7,12 +7,16 @@
 #    TAESD3 and checks the TorchScript path against the native one.
 #  - clang-format-14: the format check in ctest (.clang-format).
 #  - pybind11-dev, python3-dev, python3-numpy: `import latentpt` (python/, docs/python.md).
+#  - libopenexr-dev, libpng-dev: EXR and PNG are written directly (OpenImageIO only reads, from
+#    a plugin opened on demand: docs/performance.md, start-up).
+#  - The test suite's sanitizer replay of the fuzz corpus builds with g++; clang (for libFuzzer)
+#    is installed on demand by scripts/fuzz.sh, which alone needs it (docs/reliability.md).
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build ccache pkg-config
   libembree-dev libeigen3-dev libtbb-dev
   libtorch-dev libopenblas0-pthread
-  libopenimageio-dev openimageio-tools
+  libopenimageio-dev openimageio-tools libopenexr-dev libpng-dev
   libtinygltf-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libcli11-dev
   libgtest-dev libbenchmark-dev
   python3-torch

@@ -4,12 +4,11 @@
 //    "image_range": [-1, 1], "latent": "raw" | "model"}
 // Images cross this interface in [0, 1] and latents in the diffusion model's space; the affine
 // maps to and from the modules' own ranges happen here, so the modules stay plain exports.
+#include "vae/vae_config.h"
 #include "vae/vae_torch.h"
-#include <nlohmann/json.hpp>
 #include <torch/script.h>
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <thread>
 
@@ -37,38 +36,11 @@ std::string shape_of(const torch::Tensor& t) {
 class TorchScriptVae final : public NchwVae {
 public:
     TorchScriptVae(const std::string& encoder, const std::string& decoder, const std::string& config) {
-        std::ifstream f(config);
-        if (!f) throw std::runtime_error(config + ": VAE config not found");
-        nlohmann::json j;
-        try {
-            j = nlohmann::json::parse(f);
-        } catch (const nlohmann::json::exception& e) {
-            throw std::runtime_error(config + ": malformed JSON: " + e.what());
-        }
-        auto field = [&](const char* k) -> const nlohmann::json& {
-            if (!j.contains(k)) throw std::runtime_error(config + ": missing field '" + k + "'");
-            return j[k];
-        };
-        try {
-            m_conv.channels = field("channels").get<int>();
-            m_conv.downsample = field("downsample").get<int>();
-            m_conv.scale = field("scale").get<float>();
-            m_conv.shift = field("shift").get<float>();
-            const auto range = field("image_range").get<std::vector<float>>();
-            if (range.size() != 2 || !(range[1] > range[0]))
-                throw std::runtime_error(config + ": field 'image_range' must be [low, high] with low < high");
-            m_lo = range[0];
-            m_hi = range[1];
-            const std::string latent = field("latent").get<std::string>();
-            if (latent != "raw" && latent != "model")
-                throw std::runtime_error(config + ": field 'latent' must be \"raw\" or \"model\", got \"" + latent +
-                                         "\"");
-            m_raw = latent == "raw";
-        } catch (const nlohmann::json::exception& e) {
-            throw std::runtime_error(config + ": wrong type of a field: " + e.what());
-        }
-        if (m_conv.channels < 1 || m_conv.downsample < 1 || m_conv.scale == 0.f)
-            throw std::runtime_error(config + ": channels and downsample must be >= 1 and scale non-zero");
+        const VaeConfig c = read_vae_config(config);
+        m_conv = c.convention;
+        m_lo = c.image_lo;
+        m_hi = c.image_hi;
+        m_raw = c.raw_latent;
         m_encoder_path = encoder;
         m_decoder_path = decoder;
         m_enc = load_module(encoder, "encoder");
