@@ -63,11 +63,13 @@ struct BenchArgs {
     std::string reference;     ///< --equal-noise: converged reference (default: Tungsten's, cornell box)
     int target_spp = 64;       ///< --equal-noise: target = the independent sampler's noise at this spp
     int seeds = 2;             ///< --equal-noise: renders per ladder point
+    bool startup = false;      ///< process start-up times of light and heavy commands
 };
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);
 int run_bench_equal_error(const BenchArgs& args);
 int run_bench_equal_noise(const BenchArgs& args);
+int run_bench_startup(const BenchArgs& args);
 
 /// `latentpt refine` and `latentpt fit`: the pipeline's jobs plus what only a terminal needs.
 struct RefineArgs {

@@ -6,6 +6,7 @@
 namespace lpt::app {
 
 int run_fit(const FitArgs& a) {
+    pipeline::validate(a.job);
     const pipeline::FitSummary s = pipeline::run_fit(a.job, console_reporter(a.quiet));
     if (s.refined && !a.quiet) print_refine_summary(a.job.out, *s.refined);
     return 0;

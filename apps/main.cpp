@@ -1,6 +1,7 @@
 // latentpt command line: `latentpt <subcommand> --help` describes each subcommand. This is the
 // only translation unit that includes CLI11; each subcommand's options fill a plain struct.
 #include "apps/commands.h"
+#include "apps/torch_commands.h"
 #include "integrators/path.h"
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -184,6 +185,9 @@ struct Cli {
                          "with --equal-noise: target = the independent sampler's noise at this spp (4 ... 256)")
             ->capture_default_str()
             ->check(CLI::Range(4, 256));
+        bench->add_flag("--startup", b.startup,
+                        "seconds from exec to exit of --help, a 1-spp 16x16 render and commands that open the "
+                        "torch or image plugin (5 x --seeds runs each)");
         bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")
             ->capture_default_str()
             ->check(positive());
@@ -360,27 +364,27 @@ struct Cli {
     int run() {
         if (*render) {
             r.defines = parse_defines(defines);
-            return r.edit.empty() ? run_render(r) : run_render_edit(r);
+            return r.edit.empty() ? run_render(r) : torch_commands().render_edit(r);
         }
         if (*bench)
-            return !b.equal_error.empty() ? run_bench_equal_error(b)
+            return !b.equal_error.empty() ? torch_commands().bench_equal_error(b)
                    : b.equal_noise        ? run_bench_equal_noise(b)
+                   : b.startup            ? run_bench_startup(b)
                    : b.fit                ? run_bench_fit(b)
                                           : run_bench(b);
-        if (*encode) return run_encode(v);
-        if (*decode) return run_decode(v);
+        if (*encode) return torch_commands().encode(v);
+        if (*decode) return torch_commands().decode(v);
         if (*viz) return run_viz(v);
-        if (*metrics) return run_metrics(m);
+        if (*metrics) return torch_commands().metrics(m);
         if (*compare) {
             cmp.defines = parse_defines(cmp_defines);
             return run_compare(cmp);
         }
-        if (*refine) return run_refine(rf);
+        if (*refine) return torch_commands().refine(rf);
         if (*fit) {
             f.job.defines = parse_defines(fit_defines);
             f.job.options.tone = parse_tone_curve(fit_tone);
-            pipeline::validate(f.job);
-            return run_fit(f);
+            return torch_commands().fit(f);
         }
         return 0;
     }

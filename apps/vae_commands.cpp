@@ -1,8 +1,7 @@
-// `latentpt encode | decode | viz`: images to latents and back through the VAE (libtorch stays
-// in vae/), and a picture of a latent's channels.
+// `latentpt encode | decode`: images to latents and back through the VAE (libtorch stays in
+// vae/; this file is part of the torch plugin, apps/torch_commands.h).
 #include "apps/commands.h"
 #include "core/image_io.h"
-#include "core/latent_viz.h"
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
 #include <filesystem>
@@ -54,13 +53,6 @@ int run_decode(const VaeArgs& a) {
     if (fs::path(a.out).extension() == ".exr") write_exr(a.out, out);
     else write_png_display(a.out, out);
     if (!a.quiet) std::cerr << "wrote " << a.out << " (" << out.width << "x" << out.height << ")\n";
-    return 0;
-}
-
-int run_viz(const VaeArgs& a) {
-    Image lat = read_image(a.input);
-    write_png_srgb(a.out, latent_grid(lat.data.data(), lat.width, lat.height, lat.channels));
-    if (!a.quiet) std::cerr << "wrote " << a.out << "\n";
     return 0;
 }
 
