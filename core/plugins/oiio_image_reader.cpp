@@ -18,7 +18,8 @@ public:
         m_info.channels = spec.nchannels;
         m_info.channel_names = spec.channelnames;
         const auto base = OIIO::TypeDesc::BASETYPE(spec.format.basetype);
-        m_info.is_float = base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
+        m_info.is_float =
+            base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
         m_info.is_uint8 = base == OIIO::TypeDesc::UINT8;
     }
     const ImageFileInfo& info() const override { return m_info; }
@@ -28,8 +29,8 @@ public:
 private:
     void read(OIIO::TypeDesc type, void* out) {
         if (!m_in->read_image(0, 0, 0, m_info.channels, type, out))
-            throw std::runtime_error(m_path + ": cannot decode image (truncated or corrupt?): " +
-                                     one_line(m_in->geterror()));
+            throw std::runtime_error(m_path +
+                                     ": cannot decode image (truncated or corrupt?): " + one_line(m_in->geterror()));
     }
     std::unique_ptr<OIIO::ImageInput> m_in;
     std::string m_path;
@@ -39,7 +40,8 @@ private:
 }  // namespace
 }  // namespace lpt
 
-extern "C" lpt::ImageFileReader* latentpt_open_image_file(const char* path, bool unassociated_alpha, std::string* error) {
+extern "C" lpt::ImageFileReader* latentpt_open_image_file(const char* path, bool unassociated_alpha,
+                                                          std::string* error) {
     OIIO::ImageSpec config;
     // PNG/TIFF alpha is premultiplied into the colour by default in OIIO.
     config.attribute("oiio:UnassociatedAlpha", 1);

@@ -17,7 +17,8 @@ const char* extension_of(const uint8_t* data, size_t size) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     static unsigned counter = 0;
     // A new name each time: the texture cache keys on path, size and mtime.
-    const std::string path = lpt::fuzz::write_input("image" + std::to_string(counter++ % 64) + extension_of(data, size), data, size);
+    const std::string path =
+        lpt::fuzz::write_input("image" + std::to_string(counter++ % 64) + extension_of(data, size), data, size);
     LPT_FUZZ_EXPECT_CLEAN(path, lpt::read_image(path));
     LPT_FUZZ_EXPECT_CLEAN(path, lpt::Texture::load_bitmap(path, size % 2 == 1));
     return 0;

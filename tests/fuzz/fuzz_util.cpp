@@ -89,10 +89,14 @@ std::string with_dir(std::string text) {
 void check_rejection(const std::exception& e, const std::string& name) {
     const std::string msg = e.what();
     if (std::getenv("LPT_FUZZ_SHOW")) std::fprintf(stderr, "rejected: %s\n", msg.c_str());
-    const bool names_file = msg.find(work_dir()) != std::string::npos || (!name.empty() && msg.find(name) != std::string::npos);
+    const bool names_file =
+        msg.find(work_dir()) != std::string::npos || (!name.empty() && msg.find(name) != std::string::npos);
     if (!msg.empty() && names_file && msg.find('\n') == std::string::npos) return;
     std::fprintf(stderr, "finding: rejection message %s:\n%s\n",
-                 msg.empty() ? "is empty" : names_file ? "spans lines" : "names no file", msg.c_str());
+                 msg.empty()  ? "is empty"
+                 : names_file ? "spans lines"
+                              : "names no file",
+                 msg.c_str());
     std::abort();
 }
 

@@ -28,9 +28,9 @@ std::string bundled_scene();
 }  // namespace lpt::fuzz
 
 /// Runs `body`; a std::exception is checked by check_rejection, anything else propagates.
-#define LPT_FUZZ_EXPECT_CLEAN(name, body)          \
-    try {                                          \
-        body;                                      \
-    } catch (const std::exception& e) {            \
-        ::lpt::fuzz::check_rejection(e, (name));   \
+#define LPT_FUZZ_EXPECT_CLEAN(name, body)        \
+    try {                                        \
+        body;                                    \
+    } catch (const std::exception& e) {          \
+        ::lpt::fuzz::check_rejection(e, (name)); \
     }
