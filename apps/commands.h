@@ -43,6 +43,7 @@ struct RenderArgs {
     int ref_spp = 256;
     std::string reference_cache;  ///< folder keeping path-traced reference frames for reuse
     std::string frames;           ///< with edit: "A:B", only frames A..B (inclusive)
+    bool resume = false;          ///< with edit: skip frames an earlier run finished
 };
 int run_render(const RenderArgs& args);
 int run_render_edit(const RenderArgs& args);

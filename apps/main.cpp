@@ -125,6 +125,8 @@ struct Cli {
         render->add_option("--frames", r.frames,
                            "with --edit: only frames A:B (inclusive, from 0); split jobs give the same frame files "
                            "as one, and write metrics_A-B.csv");
+        render->add_flag("--resume", r.resume,
+                         "with --edit: skip frames an earlier, interrupted run finished (frame_NNNN.done)");
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
         render->add_option("--spp", r.spp, "samples per pixel (default and 0: the scene's)")->check(non_negative());
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");

@@ -35,6 +35,7 @@ int run_render_edit(const RenderArgs& a) {
     job.reference = a.reference;
     job.ref_spp = a.ref_spp;
     job.reference_cache = a.reference_cache;
+    job.resume = a.resume;
     if (!a.frames.empty()) parse_frames(a.frames, job.first_frame, job.last_frame);
     const int frames = pipeline::render_edits(job, console_reporter(a.quiet));
     if (!a.quiet) std::cerr << "wrote " << frames << " frames to " << job.out << "\n";

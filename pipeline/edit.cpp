@@ -167,7 +167,16 @@ int render_edits(const EditJob& job, const Reporter& report) {
         throw std::invalid_argument(job.edits + ": frames " + std::to_string(first) + ":" + std::to_string(last) +
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
     for (int i = first; i <= last; ++i) {
-        const std::string row = render_frame(job, session, tools, i, w, h, out);
+        char name[64];
+        std::snprintf(name, sizeof name, "frame_%04d.done", i);
+        const fs::path done = out / name;
+        std::string row;
+        if (job.resume && fs::exists(done)) {
+            row = read_file(done.string());
+        } else {
+            row = render_frame(job, session, tools, i, w, h, out);
+            write_text_atomic(done.string(), row);
+        }
         if (job.reference) csv << row << "\n";
         StageProgress p;
         p.stage = "edit";

@@ -24,10 +24,13 @@ struct EditJob {
     /// gives the same frame files as one job, since frame i depends on i alone (seed + i). A
     /// split job writes its metrics rows to metrics_<first>-<last>.csv, so jobs never share a file.
     int first_frame = 0, last_frame = -1;
+    /// Skip frames an earlier (killed) run finished. Every frame ends by writing frame_NNNN.done
+    /// (its metrics row, or empty), atomically and last, so one there means the frame is whole.
+    bool resume = false;
 };
 
-/// Returns the number of frames written. Throws Cancelled when the reporter cancels, and
-/// std::invalid_argument for a frame range outside the sequence.
+/// Returns the number of frames in the range (rendered now or, with resume, before). Throws Cancelled when the reporter
+/// cancels, and std::invalid_argument for a frame range outside the sequence.
 int render_edits(const EditJob& job, const Reporter& report = {});
 
 }  // namespace lpt::pipeline

@@ -54,6 +54,14 @@ edits="$src/scenes/cornell-box/edits-demo.json"
 "$bin" render "$out/fit" --edit "$edits" --spp 2 -q --frames 0:2 --out "$out/edit_split"
 "$bin" render "$out/fit" --edit "$edits" --spp 2 -q --frames 3:7 --out "$out/edit_split"
 check diff -r "$out/edit_all" "$out/edit_split"
+# --resume re-renders only frames without their frame_NNNN.done (a killed job's unfinished ones).
+cp -r "$out/edit_all" "$out/edit_resume"
+rm "$out/edit_resume"/frame_0005*
+touch -d 2000-01-01 "$out/edit_resume/frame_0000.png"
+"$bin" render "$out/fit" --edit "$edits" --spp 2 -q --resume --out "$out/edit_resume"
+check test "$(stat -c %Y "$out/edit_resume/frame_0000.png")" = "$(date -d 2000-01-01 +%s)"
+check test -f "$out/edit_resume/frame_0005.done"
+check diff -r "$out/edit_all" "$out/edit_resume"
 expect_error "not within the sequence" "$bin" render "$out/fit" --edit "$edits" --frames 3:9 -q --out "$out/x"
 expect_error "A:B" "$bin" render "$out/fit" --edit "$edits" --frames 5 -q --out "$out/x"
 
