@@ -41,7 +41,11 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
     try {
         std::map<std::string, std::string> defines = m.value("defines", std::map<std::string, std::string>{});
         for (const auto& [k, v] : overrides) defines[k] = v;
-        f.scene = std::make_unique<Scene>(load_scene(m.at("scene").get<std::string>(), defines));
+        const std::string scene = m.at("scene").get<std::string>();
+        if (!fs::exists(scene))
+            throw std::runtime_error(manifest_path + ": field 'scene': " + scene +
+                                     " does not exist (moved since the fit? fit.json names it by path)");
+        f.scene = std::make_unique<Scene>(load_scene(scene, defines));
         f.model = std::make_unique<LatentModel>(*f.scene, parameterisation_from_string(m.value("param", "code")), 0);
         const std::string params_path = (dir / "params.json").string();
         if (!fs::exists(params_path)) throw std::runtime_error(params_path + ": missing");

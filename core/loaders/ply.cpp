@@ -331,6 +331,13 @@ TriangleMesh load_ply(const std::string& path) {
     for (const PlyElement& e : header.elements) {
         // Cap reservations by the bytes left so a bogus count cannot exhaust memory up front.
         const size_t reserve = std::min(e.count, body.remaining() / 2);
+        // Records without properties hold no bytes: looping over a claimed count of 10^14 of
+        // them would hang (found by fuzzing, tests/fuzz/corpus/ply).
+        if (e.props.empty()) {
+            if (e.name == "vertex" || e.name == "face")
+                throw SceneError(path, "element '" + e.name + "'", "has no properties");
+            continue;
+        }
         body.begin_element(e);
         if (e.name == "vertex" && !have_vertex) {
             have_vertex = true;
