@@ -57,7 +57,8 @@ struct Row {
 int run_bench_startup(const BenchArgs& a) {
     const std::string dir = (fs::temp_directory_path() / ("latentpt-startup-" + std::to_string(::getpid()))).string();
     fs::create_directories(dir);
-    const std::string scene = a.scene.empty() ? std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json" : a.scene;
+    const std::string scene =
+        a.scene.empty() ? std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json" : a.scene;
     std::vector<Row> rows{
         {"--help", {"--help"}},
         {"render 16x16, 1 spp", {"render", scene, "--spp", "1", "--res", "16x16", "-q", "--out", dir + "/r.exr"}},
@@ -85,8 +86,8 @@ int run_bench_startup(const BenchArgs& a) {
         std::string js = "{\"runs\": " + std::to_string(runs) + ", \"commands\": [";
         for (size_t i = 0; i < rows.size(); ++i)
             js += (i ? ", " : "") + std::string("{\"name\": \"") + rows[i].name +
-                  "\", \"median_s\": " + std::to_string(rows[i].median) + ", \"min_s\": " + std::to_string(rows[i].min) +
-                  "}";
+                  "\", \"median_s\": " + std::to_string(rows[i].median) +
+                  ", \"min_s\": " + std::to_string(rows[i].min) + "}";
         write_text_atomic(a.out_json, js + "]}\n");
     }
     return 0;
