@@ -185,7 +185,9 @@ int render_edits(const EditJob& job, const Reporter& report) {
         p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!report.step(p)) throw Cancelled("edit");
     }
-    const bool whole = first == 0 && last == frames - 1;
+    // A range given explicitly names its file even when it spans the sequence: a workflow's
+    // chunk jobs then always write metrics_A-B.csv, whatever the chunking.
+    const bool whole = job.first_frame == 0 && job.last_frame < 0;
     const std::string metrics =
         whole ? "metrics.csv" : "metrics_" + std::to_string(first) + "-" + std::to_string(last) + ".csv";
     if (job.reference) write_text_atomic((out / metrics).string(), csv.str());

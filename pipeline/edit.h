@@ -22,7 +22,8 @@ struct EditJob {
     std::string reference_cache;  ///< keeps path-traced reference frames for reuse
     /// Only frames first_frame..last_frame (inclusive; -1 = the last): a sequence split into jobs
     /// gives the same frame files as one job, since frame i depends on i alone (seed + i). A
-    /// split job writes its metrics rows to metrics_<first>-<last>.csv, so jobs never share a file.
+    /// job given a range (last_frame >= 0) writes its metrics rows to metrics_<first>-<last>.csv,
+    /// so jobs never share a file.
     int first_frame = 0, last_frame = -1;
     /// Skip frames an earlier (killed) run finished. Every frame ends by writing frame_NNNN.done
     /// (its metrics row, or empty), atomically and last, so one there means the frame is whole.

@@ -9,6 +9,8 @@
 #  - pybind11-dev, python3-dev, python3-numpy: `import latentpt` (python/, docs/python.md).
 #  - libopenexr-dev, libpng-dev: EXR and PNG are written directly (OpenImageIO only reads, from
 #    a plugin opened on demand: docs/performance.md, start-up).
+#  - snakemake: the experiment workflow (workflow/Snakefile, scripts/experiment.py). Slurm
+#    (slurm-wlm, munge) only for tests/slurm/test_quick_on_slurm.sh, which installs it on demand.
 #  - The test suite's sanitizer replay of the fuzz corpus builds with g++; clang (for libFuzzer)
 #    is installed on demand by scripts/fuzz.sh, which alone needs it (docs/reliability.md).
 set -euo pipefail
@@ -22,6 +24,7 @@ pkgs=(
   python3-torch
   clang-format-14
   pybind11-dev python3-dev python3-numpy
+  snakemake
 )
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi

@@ -116,6 +116,13 @@ if [ -d "$shared/models/taesd3" ]; then
     # From the cache: the same references, so the same metrics.
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2c"
     check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
+    # The workflow's chunk jobs (frames 0:0 and 1:1, each writing metrics_A-B.csv) merged by
+    # experiment_lib.merge_metrics: byte for byte the one job's metrics.csv (issue 20).
+    for r in 0:0 1:1; do
+        "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --frames $r --out "$out/ed2s"
+    done
+    python3 -c "import sys; sys.path.insert(0, '$src/scripts'); import experiment_lib as X; X.merge_metrics(['$out/ed2s/metrics_0-0.csv', '$out/ed2s/metrics_1-1.csv'], '$out/ed2s/metrics.csv')"
+    check cmp "$out/ed2/metrics.csv" "$out/ed2s/metrics.csv"
     check grep -q "latent_dssim,rgb_mse_x100" "$out/ed2/metrics.csv"
     check grep -q "rgb_ssim,rgb_lpips,refined_latent_mse" "$out/ed2/metrics.csv"
     check sh -c "'$bin' bench --equal-error '$out/enc' --max-spp 16 | grep -q 'latent space, MSE'"

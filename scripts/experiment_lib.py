@@ -1,0 +1,341 @@
+"""What the experiment workflow (workflow/Snakefile) computes and reports: the scenes, fits and
+edit sequences of the paper's ablation, the latentpt command of every job, and the tables,
+plots and HTML report built from the finished outputs. Python standard library only; shared by
+the Snakefile, scripts/experiment.py (its front) and the tests."""
+import base64
+import csv
+import html
+import json
+import os
+import shlex
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+# name -> (scene file under <shared>/scenes, -D overrides)
+# scene: (file under ../shared/scenes, -D defines, default reference spp). The reference traces
+# dominate the budget (docs/results.md "Budget"): at 256² a 512-spp cbox frame took 22 s on the
+# 2-core machine, 180 frames 66 min; dining-room frames cost ~2x cbox's, veach-bidir ~1.2x.
+SCENES = {
+    "cbox-specular": ("cbox/cbox_specular.xml", [], 256),
+    "veach-bidir": ("veach-bidir/scene_v3.xml", [], 256),
+    "dining-room": ("dining-room/scene_diffuse.xml", [], 128),
+}
+KINDS = ["camera", "light", "object"]
+CONFIGS = [("e", "Ĩe"), ("ea", "+Ĩa"), ("eac", "+Ĩc"), ("eac+refiner", "+refiner"),
+           ("baseline", "baseline [0,1)+logit"), ("baseline+refiner", "baseline + refiner")]
+# Fits: name -> (terms, extra fit arguments, trains a refiner). The baseline is the paper's
+# comparison: a classic non-negative 16-channel render in [0, 1), logit to latent space
+# (--param classic --tone logit), Ĩe only, the same refiner; its lr is raised to 1.0 because
+# its radiances must grow from ~0.1 to ~10 (measured on the Cornell box: Huber 2.6 at lr 0.05,
+# 1.3 at lr 1.0 after 600 iterations).
+FITS = {"e": ("e", [], False, 0.05), "ea": ("ea", [], False, 0.05), "eac": ("eac", [], True, 0.05),
+        "baseline": ("e", ["--param", "classic", "--tone", "logit"], True, 1.0)}
+
+
+def read_metrics(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def mean(rows, key):
+    vals = [float(r[key]) for r in rows if r.get(key, "") not in ("", None)]
+    return sum(vals) / len(vals) if vals else float("nan")
+
+
+def svg_plot(title, series, ylabel, xlabel="frame", xticks=None, width=480, height=260):
+    """A minimal line chart: series = [(label, colour, [y per x position])]. The x axis is the
+    frame index, or the labels `xticks` (one per position, e.g. spp) under `xlabel`."""
+    pad_l, pad_r, pad_t, pad_b = 56, 110, 28, 36
+    ys = [y for _, _, v in series for y in v if y == y]
+    if not ys:
+        return ""
+    lo, hi = min(0.0, min(ys)), max(ys) * 1.05 or 1.0
+    n = max(len(v) for _, _, v in series)
+    sx = lambda i: pad_l + (width - pad_l - pad_r) * (i / max(1, n - 1))
+    sy = lambda y: height - pad_b - (height - pad_t - pad_b) * ((y - lo) / (hi - lo))
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" font-family="sans-serif" font-size="11">',
+           f'<text x="{width / 2}" y="16" text-anchor="middle" font-size="13">{html.escape(title)}</text>',
+           f'<line x1="{pad_l}" y1="{height - pad_b}" x2="{width - pad_r}" y2="{height - pad_b}" stroke="black"/>',
+           f'<line x1="{pad_l}" y1="{pad_t}" x2="{pad_l}" y2="{height - pad_b}" stroke="black"/>',
+           f'<text x="{(pad_l + width - pad_r) / 2}" y="{height - 6}" text-anchor="middle">{html.escape(xlabel)}</text>',
+           f'<text x="14" y="{height / 2}" transform="rotate(-90 14 {height / 2})" text-anchor="middle">{html.escape(ylabel)}</text>']
+    ticks = xticks or [str(i) for i in range(n)] if n <= 12 else None
+    for i, t in enumerate(ticks or []):
+        out.append(f'<text x="{sx(i):.1f}" y="{height - pad_b + 13}" text-anchor="middle">{html.escape(str(t))}</text>')
+    for k in range(5):
+        y = lo + (hi - lo) * k / 4
+        out.append(f'<text x="{pad_l - 4}" y="{sy(y) + 4:.1f}" text-anchor="end">{y:.3g}</text>')
+    for j, (label, colour, v) in enumerate(series):
+        pts = " ".join(f"{sx(i):.1f},{sy(y):.1f}" for i, y in enumerate(v) if y == y)
+        out.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.6" points="{pts}"/>')
+        out.append(f'<text x="{width - pad_r + 8}" y="{pad_t + 14 * j + 10}" fill="{colour}">{html.escape(label)}</text>')
+    out.append("</svg>")
+    return "\n".join(out)
+
+
+def img_tag(path, width=160):
+    if not os.path.exists(path):
+        return "<td>(missing)</td>"
+    with open(path, "rb") as f:
+        data = base64.b64encode(f.read()).decode()
+    return f'<td><img width="{width}" src="data:image/png;base64,{data}"/></td>'
+
+
+def write_atomic(path, text):
+    """Writes text to path through a temporary file and a rename: never a truncated result."""
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def write_outputs(out, c, summary, failures, timings):
+    """summary.md/json, the SVG plots and report.html under `out`. summary.json holds results
+    only (no timings: a cluster run and a local run of one config give the same file);
+    timings.json holds the job times."""
+    image_res, fit_its, ref_its, frames = c["image_res"], c["fit_iterations"], c["refiner_iterations"], c["frames"]
+    # Tables (markdown) and plots.
+    colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
+               "baseline+refiner": "#e377c2"}
+    md = ["# latentpt experiment summary", "",
+          f"settings: image {image_res}² (latents {image_res // 8}²), reference spp per scene below, stage 1 {fit_its} iterations, "
+          f"refiner {ref_its} iterations, frames {frames or 'as in the edit files'}, edited latents {c['spp']} spp", ""]
+    for scene, s in summary.items():
+        t = s["training_view"]
+        md += [f"## {scene}", "", f"References: {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
+               ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
+                         for k in ("rendered", "refined", "vae_roundtrip") if k in t), "",
+               "| edit | config | LPIPS | MSE×100 | latent D-SSIM |", "|---|---|---|---|---|"]
+        for kind, table in s["edits"].items():
+            for key, label in CONFIGS:
+                r = table[key]
+                md.append(f"| {kind} | {label} | {r['rgb_lpips']:.4f} | {r['rgb_mse_x100']:.4f} | {r['latent_dssim']:.4f} |")
+            for metric, ylabel in (("lpips", "LPIPS (decoded)"), ("dssim", "D-SSIM (latent)")):
+                svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in CONFIGS], ylabel)
+                write_atomic(os.path.join(out, f"{scene}_{kind}_{metric}.svg"), svg)
+        if "convergence" in s:
+            md += ["", "Convergence of the eac fit vs latent spp (latent D-SSIM / decoded LPIPS; rendered → refined):", "",
+                   "| view | spp | D-SSIM | refined D-SSIM | LPIPS | refined LPIPS |", "|---|---|---|---|---|---|"]
+            for view, by_spp in s["convergence"].items():
+                for spp, r in by_spp.items():
+                    md.append(f"| {view} | {spp} | {r['latent_dssim']:.4f} | {r['refined_latent_dssim']:.4f} | {r['rgb_lpips']:.4f} | {r['refined_rgb_lpips']:.4f} |")
+                svg = svg_plot(f"{scene}, {view} view: error vs spp ({', '.join(map(str, by_spp))})",
+                               [(lab, col, [r[k] for r in by_spp.values()]) for k, lab, col in
+                                (("latent_dssim", "D-SSIM", "#1f77b4"), ("refined_latent_dssim", "D-SSIM refined", "#2ca02c"),
+                                 ("rgb_lpips", "LPIPS", "#ff7f0e"), ("refined_rgb_lpips", "LPIPS refined", "#d62728"))],
+                               "error", xlabel="latent samples per pixel", xticks=list(by_spp))
+                write_atomic(os.path.join(out, f"{scene}_convergence_{view}.svg"), svg)
+        t = timings.get(scene, {})
+        if t.get("stages"):
+            md += ["", f"Job time for {scene} (sum over its jobs, from Snakemake's benchmarks; jobs that ran in "
+                   "parallel overlap, finished jobs reused from an earlier run count once): " +
+                   ", ".join(f"{k} {v / 60:.1f} min" for k, v in t["stages"].items())]
+        if t.get("equal_error"):
+            md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
+                   t["equal_error"].rstrip(), "```"]
+        md.append("")
+    if failures:
+        md += ["## Ordering check failed", ""] + [f"- {x}" for x in failures]
+    write_atomic(os.path.join(out, "summary.md"), "\n".join(md) + "\n")
+    write_atomic(os.path.join(out, "summary.json"), json.dumps({"scenes": summary, "failures": failures}, indent=1))
+    write_atomic(os.path.join(out, "timings.json"), json.dumps(timings, indent=1))
+
+    # Self-contained HTML report.
+    h = ["<!doctype html><html><head><meta charset='utf-8'><title>latentpt experiments</title>",
+         "<style>body{font-family:sans-serif;margin:2em;max-width:1200px} table{border-collapse:collapse} "
+         "td,th{border:1px solid #ccc;padding:3px 8px} img{image-rendering:pixelated}</style></head><body>",
+         "<h1>latentpt experiments</h1>", f"<p>{html.escape(md[2])}</p>"]
+    for scene, s in summary.items():
+        h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
+        for kind, table in s["edits"].items():
+            for key, label in CONFIGS:
+                r = table[key]
+                h.append(f"<tr><td>{kind}</td><td>{html.escape(label)}</td><td>{r['rgb_lpips']:.4f}</td><td>{r['rgb_mse_x100']:.4f}</td>"
+                         f"<td>{r['latent_dssim']:.4f}</td></tr>")
+        h.append("</table>")
+        for view in s.get("convergence", {}):
+            with open(os.path.join(out, f"{scene}_convergence_{view}.svg")) as f:
+                h.append(f.read())
+        for kind in s["edits"]:
+            for metric in ("lpips", "dssim"):
+                with open(os.path.join(out, f"{scene}_{kind}_{metric}.svg")) as f:
+                    h.append(f.read())
+            n = len(s["edits"][kind]["e"]["per_frame_lpips"])
+            h.append(f"<h3>{kind}: reference / Ĩe / +Ĩa+Ĩc / +refiner / baseline + refiner</h3><table>")
+            for i in sorted({0, n // 2, n - 1}):
+                d = os.path.join(out, scene)
+                h.append("<tr><td>frame %d</td>" % i + img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_reference.png")) +
+                         img_tag(os.path.join(d, f"{kind}_e", f"frame_{i:04d}.png")) +
+                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_rendered.png")) +
+                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}.png")) +
+                         img_tag(os.path.join(d, f"{kind}_baseline", f"frame_{i:04d}.png")) + "</tr>")
+            h.append("</table>")
+    if failures:
+        h.append("<h2>Ordering check failed</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in failures) + "</ul>")
+    h.append("</body></html>")
+    write_atomic(os.path.join(out, "report.html"), "\n".join(h))
+    return md
+
+
+
+
+# ---- the workflow's configuration and jobs ----
+
+def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
+             fit_iterations=None, refiner_iterations=None, spp=64, chunk=8):
+    """The workflow's config (JSON-able): --quick's small sizes or the full run's."""
+    return {"quick": quick, "scenes": scenes or (["cbox-specular"] if quick else list(SCENES)),
+            "out": os.path.abspath(out or os.path.join(ROOT, "results")),
+            "bin": os.path.abspath(bin or os.path.join(ROOT, "build", "apps", "latentpt")),
+            "shared": os.path.abspath(shared or os.environ.get("LATENTPT_SHARED", os.path.join(ROOT, "..", "shared"))),
+            "root": ROOT, "image_res": image_res or (128 if quick else 256),
+            "fit_iterations": fit_iterations or (300 if quick else 1500),
+            "refiner_iterations": refiner_iterations or (100 if quick else 1000),
+            "frames": frames or (3 if quick else None), "ref_spp": ref_spp or (32 if quick else None), "spp": spp,
+            "spp_list": [1, 4, 16, 64] if quick else [1, 4, 16, 64, 256, 1024], "chunk": chunk}
+
+
+def scene_file(c, scene):
+    return os.path.join(c["shared"], "scenes", SCENES[scene][0])
+
+
+def ref_spp_of(c, scene):
+    return c["ref_spp"] or SCENES[scene][2]
+
+
+def frame_count(c, scene, kind):
+    if c["frames"]:
+        return c["frames"]
+    with open(os.path.join(c["root"], "scenes", scene, f"edits-{kind}.json")) as f:
+        return json.load(f).get("frames", 60)
+
+
+def chunks(c, scene, kind):
+    """Frame ranges (first, last) of one sequence's jobs."""
+    n, k = frame_count(c, scene, kind), max(1, c["chunk"])
+    return [(a, min(a + k - 1, n - 1)) for a in range(0, n, k)]
+
+
+def fit_command(c, scene, name, threads):
+    """`latentpt fit` of one ablation fit; --resume continues a killed one from its checkpoint."""
+    terms, extra, refine, lr = FITS[name]
+    its, res = c["fit_iterations"], c["image_res"]
+    d = os.path.join(scene, "fit_" + name)
+    cmd = [c["bin"], "--threads", str(threads), "fit", scene_file(c, scene), "--encode", "--encode-res", f"{res}x{res}",
+           "--ref-spp", str(ref_spp_of(c, scene)), "--iterations", str(its), "--spp", "4", "--lr", str(lr),
+           "--lr-period", str(its), "--final-spp", "64", "--terms", terms, "-q", "--out", d] + extra
+    cmd += ["--refiner-iterations", str(c["refiner_iterations"])] if refine else ["--no-refiner"]
+    for define in SCENES[scene][1]:
+        cmd += ["-D", define]
+    return shlex.join(cmd) + f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume)"
+
+
+def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
+    """`latentpt render --edit --reference` of frames A:B (all when None), resuming a killed job."""
+    cmd = [c["bin"], "--threads", str(threads), "render", os.path.join(scene, "fit_" + fit), "--edit", edits,
+           "--reference", "--ref-spp", str(ref_spp_of(c, scene)), "--reference-cache", os.path.join(scene, "refs"),
+           "--spp", str(spp), "-q", "--resume", "--out", out]
+    if frames:
+        cmd += ["--frames", f"{frames[0]}:{frames[1]}"]
+    return shlex.join(cmd)
+
+
+def edit_sequence(c, scene, kind):
+    """The edit file of a sequence, with the frame count of this config."""
+    with open(os.path.join(c["root"], "scenes", scene, f"edits-{kind}.json")) as f:
+        e = json.load(f)
+    if c["frames"]:
+        e["frames"] = c["frames"]
+    return e
+
+
+def view_sequence(c, scene, view):
+    """One frame: the training view, or the camera edit's last keyframe held (a novel view)."""
+    if view == "training":
+        return {"frames": 1}
+    with open(os.path.join(c["root"], "scenes", scene, "edits-camera.json")) as f:
+        orbit = dict(json.load(f)["camera"]["orbit"])
+    for k in ("azimuth", "elevation"):
+        if isinstance(orbit.get(k), list):
+            orbit[k] = orbit[k][-1]
+    return {"frames": 1, "camera": {"orbit": orbit}}
+
+
+def merge_metrics(parts, out):
+    """metrics.csv of a sequence from its chunks' metrics_A-B.csv: one header, rows in order,
+    byte for byte what one job over the whole sequence writes."""
+    lines = []
+    for i, p in enumerate(parts):
+        with open(p) as f:
+            rows = f.read().splitlines(keepends=True)
+        lines += rows if i == 0 else rows[1:]
+    write_atomic(out, "".join(lines))
+
+
+def sequence_table(rows):
+    """Per config: mean metrics and per-frame curves of one edit sequence."""
+    table = {}
+    for key, _ in CONFIGS:
+        src, pre = (rows[key[:-len("+refiner")]], "refined_") if key.endswith("+refiner") else (rows[key], "")
+        table[key] = {m: mean(src, pre + m) for m in ("rgb_lpips", "rgb_mse_x100", "latent_dssim", "latent_mse")}
+        table[key]["per_frame_lpips"] = [float(r[pre + "rgb_lpips"] or "nan") for r in src]
+        table[key]["per_frame_dssim"] = [float(r[pre + "latent_dssim"] or "nan") for r in src]
+    return table
+
+
+def without_timings(d):
+    """A results dict without its wall-clock entries ("seconds*"), which differ run to run."""
+    if not isinstance(d, dict):
+        return d
+    return {k: without_timings(v) for k, v in d.items() if not k.startswith("seconds")}
+
+
+def scene_summary(c, out, scene, failures):
+    """Results of one scene from its finished outputs under `out`; ordering failures appended."""
+    d = os.path.join(out, scene)
+    with open(os.path.join(d, "fit_eac", "metrics.json")) as f:
+        train = without_timings(json.load(f))
+    s = {"training_view": train, "ref_spp": ref_spp_of(c, scene), "edits": {}, "convergence": {}}
+    r_l, f_l = train["rendered"].get("rgb_lpips"), train["refined"].get("rgb_lpips")
+    if r_l is not None and f_l is not None and f_l > r_l * 1.0001:
+        failures.append(f"{scene}: refiner worse than the rendered latent on the training view (LPIPS {f_l:.4f} > {r_l:.4f})")
+    for kind in KINDS:
+        table = sequence_table({name: read_metrics(os.path.join(d, f"{kind}_{name}", "metrics.csv")) for name in FITS})
+        s["edits"][kind] = table
+        base = table["e"]["rgb_lpips"]
+        for key in ("ea", "eac"):
+            if table[key]["rgb_lpips"] > base * 1.05:
+                failures.append(f"{scene}/{kind}: {key} LPIPS {table[key]['rgb_lpips']:.4f} worse than e alone {base:.4f}")
+    for view in ("training", "novel"):
+        s["convergence"][view] = {}
+        for spp in c["spp_list"]:
+            r = read_metrics(os.path.join(d, f"conv_{view}_{spp}", "metrics.csv"))[0]
+            s["convergence"][view][spp] = {k: float(r[k] or "nan") for k in
+                                           ("latent_dssim", "rgb_lpips", "refined_latent_dssim", "refined_rgb_lpips")}
+    return s
+
+
+STAGES = {"fit": "fits", "edit": "edits (references + renders)", "conv": "convergence", "equal": "equal-error benchmark"}
+
+
+def job_times(out, scene):
+    """Seconds per stage summed over the scene's jobs (Snakemake's benchmark files)."""
+    times = {}
+    bdir = os.path.join(out, scene, "benchmarks")
+    for name in sorted(os.listdir(bdir)) if os.path.isdir(bdir) else []:
+        with open(os.path.join(bdir, name)) as f:
+            rows = list(csv.DictReader(f, delimiter="\t"))
+        stage = STAGES.get(name.split("_")[0], name.split("_")[0])
+        times[stage] = times.get(stage, 0.0) + sum(float(r["s"]) for r in rows)
+    return times
+
+
+def write_summary(c, out):
+    """summary.md, summary.json, timings.json, plots and report.html of every scene of `c`."""
+    failures, summary, timings = [], {}, {}
+    for scene in c["scenes"]:
+        summary[scene] = scene_summary(c, out, scene, failures)
+        with open(os.path.join(out, scene, "equal_error.txt")) as f:  # timings: not in summary.json
+            timings[scene] = {"stages": job_times(out, scene), "equal_error": f.read()}
+    return write_outputs(out, c, summary, failures, timings), failures
