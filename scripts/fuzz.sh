@@ -5,6 +5,7 @@
 # Seeds: tests/fuzz/corpus/<harness> plus small files of the same kind from ../shared (scenes,
 # meshes, textures). A crash, leak, hang or rejection without a file name is copied into
 # tests/fuzz/corpus/<harness>/finding-<sha1>, so the replay test keeps it.
+# Inputs that add coverage join tests/fuzz/corpus/<harness> (libFuzzer's -merge=1).
 # Prints one row per harness (executions, executions/s, findings); build-fuzz/summary.tsv.
 #   scripts/fuzz.sh [--seconds N] [--jobs J] [harness ...]
 set -euo pipefail
@@ -60,6 +61,12 @@ run_one() {
     -close_fd_mask=1 >"$log" 2>&1
   local rc=$?
   set -e
+  # Keep what raised coverage: inputs that add features to the saved corpus join it (named by
+  # their SHA-1), so fuzz.replay.* replays them. Not for fit_state, whose inputs are ~30 kB.
+  if [[ "$h" != fit_state ]]; then
+    ASAN_OPTIONS=detect_leaks=0 build-fuzz/tests/fuzz/fuzz_"$h" -merge=1 -max_len="$max_len" \
+      tests/fuzz/corpus/"$h" "$work/corpus" >"build-fuzz/logs/$h.merge.log" 2>&1 || true
+  fi
   local execs rate findings=0
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   rate=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)

@@ -214,21 +214,24 @@ EOF
     echo "export SLURM_CONF=$dir/slurm.conf"
 }
 
+# Sends a signal, then waits up to `tenths` x 0.1 s for the process to go; fails if it stays.
+signal_and_wait() {
+    local pid=$1 comm=$2 sig=$3 tenths=$4 i
+    kill "-$sig" "$pid" 2>/dev/null || true
+    for ((i = 0; i < tenths; i++)); do
+        pid_is "$pid" "$comm" || return 0
+        sleep 0.1
+    done
+    return 1
+}
+
 # SIGTERM, wait up to ~15 s, then SIGKILL.
 stop_pid() {
-    local pid=$1 comm=$2 i
+    local pid=$1 comm=$2
     pid_is "$pid" "$comm" || return 0
-    kill -TERM "$pid" 2>/dev/null || true
-    for ((i = 0; i < 150; i++)); do
-        pid_is "$pid" "$comm" || return 0
-        sleep 0.1
-    done
+    signal_and_wait "$pid" "$comm" TERM 150 && return 0
     log "$comm ($pid) ignored SIGTERM; killing"
-    kill -KILL "$pid" 2>/dev/null || true
-    for ((i = 0; i < 50; i++)); do
-        pid_is "$pid" "$comm" || return 0
-        sleep 0.1
-    done
+    signal_and_wait "$pid" "$comm" KILL 50 && return 0
     die "$comm ($pid) did not exit"
 }
 
