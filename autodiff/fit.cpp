@@ -4,6 +4,7 @@
 #include "autodiff/path_record.h"
 #include "autodiff/lr_schedule.h"
 #include "core/image_io.h"
+#include "core/json_number.h"
 #include "core/sampler.h"
 #include <nlohmann/json.hpp>
 #include <chrono>
@@ -168,15 +169,15 @@ FitState load_checkpoint(const std::string& dir, LatentModel& model) {
     }
     FitState s;
     try {
-        s.next_iteration = j.at("next_iteration");
+        s.next_iteration = json_int(j.at("next_iteration"), state_path, "next_iteration", 0);
         s.smoothed = j.at("smoothed");
         s.best_loss = j.at("best_loss");
-        s.best_iteration = j.at("best_iteration");
-        s.bad_updates = j.at("bad_updates");
-        s.skipped_steps = j.at("skipped_steps");
+        s.best_iteration = json_int(j.at("best_iteration"), state_path, "best_iteration", -1);
+        s.bad_updates = json_int(j.at("bad_updates"), state_path, "bad_updates", 0);
+        s.skipped_steps = json_int(j.at("skipped_steps"), state_path, "skipped_steps", 0);
         s.best_raw = j.at("best_raw").get<std::vector<float>>();
         for (const auto& r : j.at("history"))
-            s.history.push_back({r.at(0).get<int>(),
+            s.history.push_back({json_int(r.at(0), state_path, "history[][0]", 0),
                                  r.at(1).get<double>(),
                                  r.at(2).get<double>(),
                                  r.at(3).get<float>(),

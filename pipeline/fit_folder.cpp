@@ -1,4 +1,5 @@
 #include "pipeline/fit_folder.h"
+#include "core/json_number.h"
 #include "core/scene_loader.h"
 #include "pipeline/fit.h"
 #include "pipeline/paths.h"
@@ -53,8 +54,8 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
         configure_terms(*f.model, m.value("gate", "shadowed"), m.value("terms", "eac"));
         f.model->sync();
         f.tone = parse_tone_curve(m.value("tone", "clip"));
-        f.latent_width = m.at("latent_width");
-        f.latent_height = m.at("latent_height");
+        f.latent_width = json_int(m.at("latent_width"), manifest_path, "latent_width", 1, 1 << 20);
+        f.latent_height = json_int(m.at("latent_height"), manifest_path, "latent_height", 1, 1 << 20);
         f.ref_tone = m.value("ref_tone", "clip");
         f.vae = vae_source_of(m);
     } catch (const nlohmann::json::exception& e) {

@@ -1,4 +1,5 @@
 #include "vae/vae_config.h"
+#include "core/json_number.h"
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -30,8 +31,8 @@ VaeConfig parse_vae_config(const std::string& text, const std::string& path) {
     };
     VaeConfig c;
     try {
-        c.convention.channels = field("channels").get<int>();
-        c.convention.downsample = field("downsample").get<int>();
+        c.convention.channels = json_int(field("channels"), path, "channels", 1, 4096);
+        c.convention.downsample = json_int(field("downsample"), path, "downsample", 1, 4096);
         c.convention.scale = field("scale").get<float>();
         c.convention.shift = field("shift").get<float>();
         const auto range = field("image_range").get<std::vector<float>>();

@@ -7,6 +7,7 @@
 #include "core/envmap.h"
 #include "core/texture.h"
 #include <nlohmann/json.hpp>
+#include <climits>
 #include <filesystem>
 #include <fstream>
 
@@ -37,6 +38,10 @@ struct Ctx {
     }
     int integer(const json& j, const std::string& field) const {
         if (!j.is_number_integer()) fail(field, "expected an integer");
+        // Beyond int's range get<int>() would wrap (2^32 + 1 spp -> 1 spp) without a word.
+        if (j.is_number_unsigned() ? j.get<unsigned long long>() > INT_MAX
+                                   : (j.get<long long>() < INT_MIN || j.get<long long>() > INT_MAX))
+            fail(field, "integer out of range");
         return j.get<int>();
     }
     std::string string(const json& j, const std::string& field) const {
