@@ -67,6 +67,35 @@ struct PlyElement {
 
 enum class PlyFormat { Ascii, BinaryLE, BinaryBE };
 
+double integer_min(PlyType t) {
+    switch (t) {
+        case PlyType::Int8:
+            return -128.0;
+        case PlyType::Int16:
+            return -32768.0;
+        case PlyType::Int32:
+            return -2147483648.0;
+        default:
+            return 0.0;
+    }
+}
+double integer_max(PlyType t) {
+    switch (t) {
+        case PlyType::Int8:
+            return 127.0;
+        case PlyType::UInt8:
+            return 255.0;
+        case PlyType::Int16:
+            return 32767.0;
+        case PlyType::UInt16:
+            return 65535.0;
+        case PlyType::Int32:
+            return 2147483647.0;
+        default:
+            return 4294967295.0;
+    }
+}
+
 /// Reads scalars from the body; every read is bounds-checked so truncation is an error, not UB.
 class PlyBody {
 public:
@@ -150,6 +179,10 @@ private:
         char* end = nullptr;
         double v = std::strtod(tok.c_str(), &end);
         if (*end != '\0' || (is_integer(t) && v != std::floor(v))) fail("bad value '" + tok + "'", record);
+        // An integer beyond its declared type (1e59 as a vertex index) is as malformed as a
+        // fraction, and later conversions to integers rely on the range.
+        if (is_integer(t) && !(v >= integer_min(t) && v <= integer_max(t)))
+            fail("value '" + tok + "' outside its integer type's range", record);
         return v;
     }
 
