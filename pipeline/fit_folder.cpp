@@ -43,7 +43,8 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
         std::map<std::string, std::string> defines = m.value("defines", std::map<std::string, std::string>{});
         for (const auto& [k, v] : overrides) defines[k] = v;
         const std::string scene = m.at("scene").get<std::string>();
-        if (!fs::exists(scene))
+        std::error_code ec;  // a name too long for the file system is an error, not an exception
+        if (!fs::exists(scene, ec))
             throw std::runtime_error(manifest_path + ": field 'scene': " + scene +
                                      " does not exist (moved since the fit? fit.json names it by path)");
         f.scene = std::make_unique<Scene>(load_scene(scene, defines));
