@@ -62,8 +62,9 @@ run_one() {
   local rc=$?
   set -e
   # Keep what raised coverage: inputs that add features to the saved corpus join it (named by
-  # their SHA-1), so fuzz.replay.* replays them. Not for fit_state, whose inputs are ~30 kB.
-  if [[ "$h" != fit_state ]]; then
+  # their SHA-1), so fuzz.replay.* replays them. Not for fit_state, whose inputs are ~30 kB, and
+  # not where ../shared seeded the run: its third-party files (and near copies) stay out of git.
+  if [[ "$h" != fit_state && -z "$(shared_seeds "$h")" ]]; then
     ASAN_OPTIONS=detect_leaks=0 build-fuzz/tests/fuzz/fuzz_"$h" -merge=1 -max_len="$max_len" \
       tests/fuzz/corpus/"$h" "$work/corpus" >"build-fuzz/logs/$h.merge.log" 2>&1 || true
   fi
