@@ -61,6 +61,8 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
         f.vae = vae_source_of(m);
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(manifest_path + ": " + e.what());
+    } catch (const std::invalid_argument& e) {  // an unknown "param" or "tone" name
+        throw std::runtime_error(manifest_path + ": " + e.what());
     }
     return f;
 }
