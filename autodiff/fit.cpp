@@ -167,8 +167,11 @@ FitState load_checkpoint(const std::string& dir, LatentModel& model) {
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(state_path + ": malformed checkpoint: " + e.what());
     }
+    if (!j.is_object()) throw std::runtime_error(state_path + ": malformed checkpoint: expected a JSON object");
     FitState s;
+    std::string tag;
     try {
+        tag = j.value("tag", std::string());
         s.next_iteration = json_int(j.at("next_iteration"), state_path, "next_iteration", 0);
         s.smoothed = j.at("smoothed");
         s.best_loss = j.at("best_loss");
@@ -187,7 +190,6 @@ FitState load_checkpoint(const std::string& dir, LatentModel& model) {
     } catch (const nlohmann::json::exception& e) {
         throw std::runtime_error(state_path + ": incomplete checkpoint: " + e.what());
     }
-    const std::string tag = j.value("tag", std::string());
     const std::string params_path = (fs::path(dir) / ("params-" + tag + ".json")).string();
     model.params().load_json(read_file(params_path), params_path);
     if (s.best_raw.size() != model.params().raw().size())

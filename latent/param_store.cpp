@@ -178,7 +178,9 @@ void ParamStore::load_json(const std::string& text, const std::string& file) {
     if (!j.contains("slices") || !j["slices"].is_array())
         throw std::runtime_error(file + ": field 'slices' missing or not an array");
     for (const auto& e : j["slices"]) {
-        std::string name = e.value("name", "");
+        if (!e.is_object() || !e.contains("name") || !e["name"].is_string())
+            throw std::runtime_error(file + ": each of 'slices' must be an object with a string 'name'");
+        const std::string name = e["name"].get<std::string>();
         int i = find(name);
         if (i < 0)
             throw std::runtime_error(file + ": unknown parameter '" + name +
@@ -188,8 +190,8 @@ void ParamStore::load_json(const std::string& text, const std::string& file) {
             throw std::runtime_error(file + ": parameter '" + name + "': 'raw' must hold " +
                                      std::to_string(s.raw_size()) + " numbers");
         if (e.contains("map") && e["map"] != to_string(s.map))
-            throw std::runtime_error(file + ": parameter '" + name + "': map '" + e["map"].get<std::string>() +
-                                     "' but this fit uses '" + to_string(s.map) + "'");
+            throw std::runtime_error(file + ": parameter '" + name + "': map " + e["map"].dump() +
+                                     " but this fit uses '" + to_string(s.map) + "'");
         for (size_t k = 0; k < s.raw_size(); ++k) {
             if (!e["raw"][k].is_number())
                 throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) +

@@ -39,6 +39,7 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
     f.dir = dir_name;
     f.manifest = parse_json_file(manifest_path);
     const nlohmann::json& m = f.manifest;
+    if (!m.is_object()) throw std::runtime_error(manifest_path + ": expected a JSON object");
     try {
         std::map<std::string, std::string> defines = m.value("defines", std::map<std::string, std::string>{});
         for (const auto& [k, v] : overrides) defines[k] = v;
