@@ -23,10 +23,17 @@ namespace fs = std::filesystem;
 std::vector<std::string> plugin_dirs() {
     std::vector<std::string> dirs;
     if (const char* env = std::getenv("LATENTPT_PLUGIN_DIR"); env && *env) dirs.push_back(env);
-    // The executable, or the Python module, that holds this code: plugins are installed beside it.
+    // The binary that holds this code (the executable, or the Python module): plugins are
+    // installed beside it or in its ../lib/latentpt. For the executable dladdr may only know
+    // argv[0] ("latentpt" found on PATH), so /proc/self/exe is asked as well.
+    std::vector<fs::path> homes;
     Dl_info self{};
-    if (dladdr(reinterpret_cast<void*>(&plugin_dirs), &self) && self.dli_fname) {
-        const fs::path here = fs::absolute(self.dli_fname).parent_path();
+    if (dladdr(reinterpret_cast<void*>(&plugin_dirs), &self) && self.dli_fname && *self.dli_fname)
+        homes.push_back(fs::absolute(self.dli_fname).parent_path());
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) homes.push_back(exe.parent_path());
+    for (const fs::path& here : homes) {
         dirs.push_back(here.string());
         dirs.push_back((here.parent_path() / "lib" / "latentpt").string());
     }
