@@ -123,8 +123,8 @@ struct Cli {
                            "with --reference: keep path-traced frames in this folder and reuse them "
                            "(keyed by edits file name, size, spp, tone and frame)");
         render->add_option("--frames", r.frames,
-                           "with --edit: only frames A:B (inclusive, from 0); split jobs give the same frame files "
-                           "as one, and write metrics_A-B.csv");
+                           "with --edit: only frames A:B (inclusive, from 0), or every S-th of them with A:B:S; split "
+                           "jobs give the same frame files as one, and write metrics_A-B.csv");
         render->add_flag("--resume", r.resume,
                          "with --edit: skip frames an earlier, interrupted run finished (frame_NNNN.done)");
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
@@ -256,6 +256,9 @@ struct Cli {
             ->capture_default_str();
         fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")
             ->capture_default_str();
+        fit->add_option("--reference-cache", f.job.reference_cache,
+                        "with --encode: keep the traced and encoded reference in this folder and reuse it (one "
+                        "folder per scene: fits of one scene share it)");
         fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")
             ->check(CLI::IsMember({"clip", "reinhard"}))
             ->capture_default_str();

@@ -10,14 +10,16 @@ namespace lpt::app {
 
 namespace {
 
-/// "A:B" with 0 <= A <= B.
-void parse_frames(const std::string& s, int& first, int& last) {
-    char colon = 0;
-    int a = -1, b = -1;
-    if (std::sscanf(s.c_str(), "%d%c%d", &a, &colon, &b) != 3 || colon != ':' || a < 0 || b < a)
-        throw std::invalid_argument("--frames expects A:B with 0 <= A <= B, got '" + s + "'");
+/// "A:B" or "A:B:S" with 0 <= A <= B and S >= 1 (every S-th frame from A).
+void parse_frames(const std::string& s, int& first, int& last, int& step) {
+    char c1 = 0, c2 = 0;
+    int a = -1, b = -1, k = 1;
+    const int n = std::sscanf(s.c_str(), "%d%c%d%c%d", &a, &c1, &b, &c2, &k);
+    if ((n != 3 && n != 5) || c1 != ':' || (n == 5 && c2 != ':') || a < 0 || b < a || k < 1)
+        throw std::invalid_argument("--frames expects A:B or A:B:S with 0 <= A <= B and S >= 1, got '" + s + "'");
     first = a;
     last = b;
+    step = k;
 }
 
 }  // namespace
@@ -36,7 +38,7 @@ int run_render_edit(const RenderArgs& a) {
     job.ref_spp = a.ref_spp;
     job.reference_cache = a.reference_cache;
     job.resume = a.resume;
-    if (!a.frames.empty()) parse_frames(a.frames, job.first_frame, job.last_frame);
+    if (!a.frames.empty()) parse_frames(a.frames, job.first_frame, job.last_frame, job.frame_step);
     const int frames = pipeline::render_edits(job, console_reporter(a.quiet));
     if (!a.quiet) std::cerr << "wrote " << frames << " frames to " << job.out << "\n";
     return 0;

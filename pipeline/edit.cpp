@@ -94,28 +94,15 @@ std::string frame_metrics(const std::vector<float>& latent, const std::vector<fl
 /// several fits on one sequence).
 std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, const Tools& t, const std::string& frame,
                                    const std::string& stem, int w, int h, std::vector<float>& ref_rgb) {
-    fs::path cached;
+    std::string cached;
     if (!job.reference_cache.empty()) {
         char key[160];
-        std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s.exr", fs::path(job.edits).stem().string().c_str(), 8 * w,
+        std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s", fs::path(job.edits).stem().string().c_str(), 8 * w,
                       8 * h, job.ref_spp, fit.ref_tone.c_str(), frame.c_str());
-        cached = fs::path(job.reference_cache) / key;
+        cached = (fs::path(job.reference_cache) / key).string();
     }
-    if (!cached.empty() && fs::exists(cached)) {
-        Image img = read_image(cached.string());
-        if (img.width != 8 * w || img.height != 8 * h || img.channels != 3)
-            throw std::runtime_error(cached.string() + ": cached reference has the wrong size");
-        ref_rgb = img.data;
-        write_png_display(stem + "_reference.png", Image{8 * w, 8 * h, 3, ref_rgb, {}});
-        return t.vae->encode(ref_rgb, 8 * w, 8 * h);
-    }
-    std::vector<float> ref = encoded_reference_of(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae,
-                                                  stem + "_reference.png", &ref_rgb);
-    if (!cached.empty()) {
-        fs::create_directories(cached.parent_path());
-        write_exr(cached.string(), Image{8 * w, 8 * h, 3, ref_rgb, {"R", "G", "B"}});
-    }
-    return ref;
+    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae, cached,
+                                    stem + "_reference.png", ref_rgb);
 }
 
 /// Renders, refines and decodes frame `i`; returns its metrics row (empty without job.reference).
@@ -166,7 +153,9 @@ int render_edits(const EditJob& job, const Reporter& report) {
     if (first < 0 || first > last || last >= frames)
         throw std::invalid_argument(job.edits + ": frames " + std::to_string(first) + ":" + std::to_string(last) +
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
-    for (int i = first; i <= last; ++i) {
+    if (job.frame_step < 1) throw std::invalid_argument("frame step must be at least 1");
+    const int count = (last - first) / job.frame_step + 1;
+    for (int i = first; i <= last; i += job.frame_step) {
         char name[64];
         std::snprintf(name, sizeof name, "frame_%04d.done", i);
         const fs::path done = out / name;
@@ -180,8 +169,8 @@ int render_edits(const EditJob& job, const Reporter& report) {
         if (job.reference) csv << row << "\n";
         StageProgress p;
         p.stage = "edit";
-        p.step = i - first + 1;
-        p.total = last - first + 1;
+        p.step = (i - first) / job.frame_step + 1;
+        p.total = count;
         p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (!report.step(p)) throw Cancelled("edit");
     }
@@ -191,7 +180,7 @@ int render_edits(const EditJob& job, const Reporter& report) {
     const std::string metrics =
         whole ? "metrics.csv" : "metrics_" + std::to_string(first) + "-" + std::to_string(last) + ".csv";
     if (job.reference) write_text_atomic((out / metrics).string(), csv.str());
-    return last - first + 1;
+    return count;
 }
 
 }  // namespace lpt::pipeline

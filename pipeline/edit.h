@@ -25,6 +25,7 @@ struct EditJob {
     /// job given a range (last_frame >= 0) writes its metrics rows to metrics_<first>-<last>.csv,
     /// so jobs never share a file.
     int first_frame = 0, last_frame = -1;
+    int frame_step = 1;  ///< only every frame_step-th frame from first_frame (a stated subset)
     /// Skip frames an earlier (killed) run finished. Every frame ends by writing frame_NNNN.done
     /// (its metrics row, or empty), atomically and last, so one there means the frame is whole.
     bool resume = false;

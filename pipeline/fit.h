@@ -24,6 +24,7 @@ struct FitJob {
     std::string encode_res = "256x256";  ///< image resolution for `encode` (latent = image / 8)
     int ref_spp = 256;
     std::string ref_tone = "clip";        ///< clip to [0, 1] or reinhard |x|/(1+|x|), then gamma 1/2.2
+    std::string reference_cache;          ///< with `encode`: folder sharing the traced reference between fits
     std::string synthetic_res = "32x32";  ///< latent resolution of the synthetic target
     uint64_t synthetic_seed = 1;
 

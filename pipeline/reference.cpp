@@ -1,10 +1,13 @@
 #include "pipeline/reference.h"
 #include "core/image_io.h"
+#include "pipeline/fit_folder.h"
 #include "core/scene.h"
 #include "integrators/path.h"
+#include "latent/latent.h"
 #include "vae/vae.h"
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -37,6 +40,30 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
     if (display_rgb) *display_rgb = rgb;
     return vae.encode(rgb, width, height);
+}
+
+std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, const std::string& tone,
+                                            const Vae& vae, const std::string& cache_stem, const std::string& save_png,
+                                            std::vector<float>& display_rgb, const Reporter& report) {
+    namespace fs = std::filesystem;
+    if (cache_stem.empty())
+        return encoded_reference_of(scene, width, height, spp, tone, vae, save_png, &display_rgb, report);
+    const std::string rgb_file = cache_stem + ".exr", latent_file = cache_stem + "_latent.exr";
+    const int f = vae.convention().downsample;
+    if (!fs::exists(rgb_file)) {
+        std::vector<float> latent =
+            encoded_reference_of(scene, width, height, spp, tone, vae, save_png, &display_rgb, report);
+        fs::create_directories(fs::path(cache_stem).parent_path());
+        write_latent(latent_file, width / f, height / f, latent);
+        write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}});
+        return latent;
+    }
+    display_rgb = read_fit_image(rgb_file, 3, width, height).data;
+    if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});
+    if (fs::exists(latent_file)) return read_fit_image(latent_file, kLatentChannels, width / f, height / f).data;
+    std::vector<float> latent = vae.encode(display_rgb, width, height);
+    write_latent(latent_file, width / f, height / f, latent);
+    return latent;
 }
 
 }  // namespace lpt::pipeline

@@ -22,4 +22,14 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
                                         const Vae& vae, const std::string& save_png,
                                         std::vector<float>* display_rgb = nullptr, const Reporter& report = {});
 
+/// encoded_reference_of through a cache: `cache_stem`.exr holds the display RGB and
+/// `cache_stem`_latent.exr its encoding. A cached reference is read (and re-encoded only when its
+/// latent file is missing); a missing one is traced and both files written, latent first, each
+/// atomically, so several jobs (an experiment's fits and edit sequences) trace a reference once
+/// and encode it once. An empty `cache_stem` caches nothing. `display_rgb` receives the display
+/// image and `save_png` (if not empty) a picture of it.
+std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, const std::string& tone,
+                                            const Vae& vae, const std::string& cache_stem, const std::string& save_png,
+                                            std::vector<float>& display_rgb, const Reporter& report = {});
+
 }  // namespace lpt::pipeline

@@ -64,6 +64,12 @@ check test -f "$out/edit_resume/frame_0005.done"
 check diff -r "$out/edit_all" "$out/edit_resume"
 expect_error "not within the sequence" "$bin" render "$out/fit" --edit "$edits" --frames 3:9 -q --out "$out/x"
 expect_error "A:B" "$bin" render "$out/fit" --edit "$edits" --frames 5 -q --out "$out/x"
+# Every S-th frame (A:B:S, issue 16's frame subsets): exactly frames 0, 3, 6, the same files as
+# the whole sequence's.
+"$bin" render "$out/fit" --edit "$edits" --spp 2 -q --frames 0:7:3 --out "$out/edit_step"
+check test "$(ls "$out/edit_step" | grep -c 'done$')" -eq 3
+for i in 0000 0003 0006; do check cmp "$out/edit_all/frame_$i.png" "$out/edit_step/frame_$i.png"; done
+expect_error "A:B:S" "$bin" render "$out/fit" --edit "$edits" --frames 0:7:0 -q --out "$out/x"
 
 expect_error "channels" "$bin" fit "$scene" --target "$out/r.exr" -q --out "$out/bad"
 expect_error "does not exist" "$bin" render "$out/missing.json" -q --out "$out/x.exr"
@@ -99,6 +105,15 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q $small_refiner --out "$out/enc"
     for f in reference.png reference_rgb.exr target.exr target_decoded.png decoded.png decoded_refined.png metrics.json; do check test -s "$out/enc/$f"; done
     check grep -q vae_roundtrip "$out/enc/metrics.json"
+    # Fits sharing a training reference through --reference-cache: traced once, the same target
+    # as a fit that traces its own.
+    for d in encc1 encc2; do
+        "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q --no-refiner --reference-cache "$out/trefs" --out "$out/$d"
+    done
+    check test "$(ls "$out/trefs" | wc -l)" -eq 2
+    check cmp "$out/enc/target.exr" "$out/encc1/target.exr"
+    check cmp "$out/enc/target.exr" "$out/encc2/target.exr"
+    check cmp "$out/enc/reference_rgb.exr" "$out/encc2/reference_rgb.exr"
     # An identity edit reproduces the fit's final latent and refined latent exactly (same seed and spp).
     printf '{"frames": 1}' > "$out/identity.json"
     "$bin" render "$out/enc" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed"
@@ -112,7 +127,7 @@ if [ -d "$shared/models/taesd3" ]; then
     printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move.json"
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2"
     check test "$(wc -l < "$out/ed2/metrics.csv")" -eq 3
-    check test "$(ls "$out/refs" | wc -l)" -eq 2
+    check test "$(ls "$out/refs" | wc -l)" -eq 4  # display RGB and its encoding per frame
     # From the cache: the same references, so the same metrics.
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2c"
     check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
