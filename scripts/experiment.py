@@ -64,6 +64,10 @@ def snakemake_command(a, config_path, out):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="one scene, small and short; checks the ablation ordering (CI)")
+    ap.add_argument("--paper", action="store_true",
+                    help="the paper-scale preset (issue 16): cbox-specular at 1024² (128² latents), veach-bidir and "
+                         "dining-room at 512², every 6th frame, 3000 stage-1 iterations, no baseline; other flags "
+                         "override its values (docs/results.md)")
     ap.add_argument("--scenes", default=None, help="comma-separated subset of " + ", ".join(X.SCENES))
     ap.add_argument("--out", default=os.path.join(X.ROOT, "results"))
     ap.add_argument("--bin", default=os.path.join(X.ROOT, "build", "apps", "latentpt"))
@@ -73,6 +77,7 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=None, help="samples per pixel of the RGB references (default: per scene, 128-256)")
     ap.add_argument("--fit-iterations", type=int, default=None)
     ap.add_argument("--refiner-iterations", type=int, default=None)
+    ap.add_argument("--frame-step", type=int, default=None, help="evaluate every N-th frame of each edit sequence (default 1)")
     ap.add_argument("--spp", type=int, default=64, help="latent samples per pixel of the edited frames")
     ap.add_argument("--chunk", type=int, default=8, help="frames per edit job (the unit a cluster spreads)")
     ap.add_argument("--cores", type=int, default=os.cpu_count(),
@@ -84,7 +89,8 @@ def main():
     a = ap.parse_args()
     c = X.settings(quick=a.quick, scenes=a.scenes.split(",") if a.scenes else None, out=a.out, bin=a.bin,
                    shared=a.shared, image_res=a.image_res, frames=a.frames, ref_spp=a.ref_spp,
-                   fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk)
+                   fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk,
+                   paper=a.paper, frame_step=a.frame_step)
     for s in c["scenes"]:
         if s not in X.SCENES:
             sys.exit(f"experiment: unknown scene '{s}' (have {', '.join(X.SCENES)})")

@@ -98,21 +98,26 @@ def write_outputs(out, c, summary, failures, timings):
     # Tables (markdown) and plots.
     colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
                "baseline+refiner": "#e377c2"}
+    configs, step = configs_of(c), c.get("frame_step", 1)
     md = ["# latentpt experiment summary", "",
-          f"settings: image {image_res}² (latents {image_res // 8}²), reference spp per scene below, stage 1 {fit_its} iterations, "
-          f"refiner {ref_its} iterations, frames {frames or 'as in the edit files'}, edited latents {c['spp']} spp", ""]
+          f"settings: image {image_res}² (latents {image_res // 8}²) unless said per scene, reference spp per scene below, "
+          f"stage 1 {fit_its} iterations, refiner {ref_its} iterations, frames {frames or 'as in the edit files'}"
+          f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp", ""]
     for scene, s in summary.items():
         t = s["training_view"]
-        md += [f"## {scene}", "", f"References: {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
+        res = image_res_of(c, scene)
+        md += [f"## {scene}", "", f"Image {res}² (latents {res // 8}²). References: training view {training_ref_spp_of(c, scene)} spp, "
+               f"edited frames {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
                ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
                          for k in ("rendered", "refined", "vae_roundtrip") if k in t), "",
                "| edit | config | LPIPS | MSE×100 | latent D-SSIM |", "|---|---|---|---|---|"]
         for kind, table in s["edits"].items():
-            for key, label in CONFIGS:
+            for key, label in configs:
                 r = table[key]
                 md.append(f"| {kind} | {label} | {r['rgb_lpips']:.4f} | {r['rgb_mse_x100']:.4f} | {r['latent_dssim']:.4f} |")
             for metric, ylabel in (("lpips", "LPIPS (decoded)"), ("dssim", "D-SSIM (latent)")):
-                svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in CONFIGS], ylabel)
+                svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in configs],
+                               ylabel, xlabel="frame of the edit sequence", xticks=table["e"].get("frames") if step > 1 else None)
                 write_atomic(os.path.join(out, f"{scene}_{kind}_{metric}.svg"), svg)
         if "convergence" in s:
             md += ["", "Convergence of the eac fit vs latent spp (latent D-SSIM / decoded LPIPS; rendered → refined):", "",
@@ -149,7 +154,7 @@ def write_outputs(out, c, summary, failures, timings):
     for scene, s in summary.items():
         h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
         for kind, table in s["edits"].items():
-            for key, label in CONFIGS:
+            for key, label in configs:
                 r = table[key]
                 h.append(f"<tr><td>{kind}</td><td>{html.escape(label)}</td><td>{r['rgb_lpips']:.4f}</td><td>{r['rgb_mse_x100']:.4f}</td>"
                          f"<td>{r['latent_dssim']:.4f}</td></tr>")
@@ -161,15 +166,16 @@ def write_outputs(out, c, summary, failures, timings):
             for metric in ("lpips", "dssim"):
                 with open(os.path.join(out, f"{scene}_{kind}_{metric}.svg")) as f:
                     h.append(f.read())
-            n = len(s["edits"][kind]["e"]["per_frame_lpips"])
-            h.append(f"<h3>{kind}: reference / Ĩe / +Ĩa+Ĩc / +refiner / baseline + refiner</h3><table>")
-            for i in sorted({0, n // 2, n - 1}):
+            frames = s["edits"][kind]["e"]["frames"]
+            base = "baseline" in fits_of(c)
+            h.append(f"<h3>{kind}: reference / Ĩe / +Ĩa+Ĩc / +refiner{' / baseline + refiner' if base else ''}</h3><table>")
+            for i in sorted({frames[0], frames[len(frames) // 2], frames[-1]}):
                 d = os.path.join(out, scene)
                 h.append("<tr><td>frame %d</td>" % i + img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_reference.png")) +
                          img_tag(os.path.join(d, f"{kind}_e", f"frame_{i:04d}.png")) +
                          img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_rendered.png")) +
                          img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}.png")) +
-                         img_tag(os.path.join(d, f"{kind}_baseline", f"frame_{i:04d}.png")) + "</tr>")
+                         (img_tag(os.path.join(d, f"{kind}_baseline", f"frame_{i:04d}.png")) if base else "") + "</tr>")
             h.append("</table>")
     if failures:
         h.append("<h2>Ordering check failed</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in failures) + "</ul>")
@@ -182,18 +188,51 @@ def write_outputs(out, c, summary, failures, timings):
 
 # ---- the workflow's configuration and jobs ----
 
+# The paper-scale preset (issue 16, docs/results.md "Table 1 at the paper's scale"): the paper's
+# 1024² images / 128² latents on cbox-specular, 512² on the two larger scenes, every 6th frame of
+# the 60, the paper's 3000 stage-1 iterations; no baseline fit (not in the paper's Table 1).
+PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
+         "scene_res": {"cbox-specular": 1024, "veach-bidir": 512, "dining-room": 512},
+         "frame_step": 6, "ref_spp": 128, "training_ref_spp": 1024, "fit_iterations": 3000,
+         "refiner_iterations": 1000, "fits": ["e", "ea", "eac"], "spp_list": [1, 4, 16, 64, 256],
+         "equal_error_max_spp": 128}
+
+
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
-             fit_iterations=None, refiner_iterations=None, spp=64, chunk=8):
-    """The workflow's config (JSON-able): --quick's small sizes or the full run's."""
-    return {"quick": quick, "scenes": scenes or (["cbox-specular"] if quick else list(SCENES)),
+             fit_iterations=None, refiner_iterations=None, spp=64, chunk=8, paper=False, frame_step=None):
+    """The workflow's config (JSON-able): --quick's small sizes, --paper's preset or the full run's;
+    flags given explicitly win over the preset's values."""
+    p = PAPER if paper else {}
+    return {"quick": quick, "paper": paper, "scenes": scenes or p.get("scenes") or (["cbox-specular"] if quick else list(SCENES)),
             "out": os.path.abspath(out or os.path.join(ROOT, "results")),
             "bin": os.path.abspath(bin or os.path.join(ROOT, "build", "apps", "latentpt")),
             "shared": os.path.abspath(shared or os.environ.get("LATENTPT_SHARED", os.path.join(ROOT, "..", "shared"))),
             "root": ROOT, "image_res": image_res or (128 if quick else 256),
-            "fit_iterations": fit_iterations or (300 if quick else 1500),
-            "refiner_iterations": refiner_iterations or (100 if quick else 1000),
-            "frames": frames or (3 if quick else None), "ref_spp": ref_spp or (32 if quick else None), "spp": spp,
-            "spp_list": [1, 4, 16, 64] if quick else [1, 4, 16, 64, 256, 1024], "chunk": chunk}
+            "scene_res": {} if image_res else p.get("scene_res", {}),
+            "fit_iterations": fit_iterations or p.get("fit_iterations") or (300 if quick else 1500),
+            "refiner_iterations": refiner_iterations or p.get("refiner_iterations") or (100 if quick else 1000),
+            "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
+            "ref_spp": ref_spp or p.get("ref_spp") or (32 if quick else None),
+            "training_ref_spp": p.get("training_ref_spp"), "fits": p.get("fits", list(FITS)), "spp": spp,
+            "spp_list": [1, 4, 16, 64] if quick else p.get("spp_list", [1, 4, 16, 64, 256, 1024]), "chunk": chunk,
+            "equal_error_max_spp": p.get("equal_error_max_spp", 1024)}
+
+
+def image_res_of(c, scene):
+    return c.get("scene_res", {}).get(scene, c["image_res"])
+
+
+def training_ref_spp_of(c, scene):
+    return c.get("training_ref_spp") or ref_spp_of(c, scene)
+
+
+def fits_of(c):
+    return c.get("fits", list(FITS))
+
+
+def configs_of(c):
+    """The table's columns of this run: CONFIGS whose fit ran."""
+    return [(k, lab) for k, lab in CONFIGS if k.split("+")[0] in fits_of(c)]
 
 
 def scene_file(c, scene):
@@ -211,24 +250,40 @@ def frame_count(c, scene, kind):
         return json.load(f).get("frames", 60)
 
 
+def frames_evaluated(c, scene, kind):
+    """The frames of a sequence that are rendered and scored: every frame_step-th from 0."""
+    return list(range(0, frame_count(c, scene, kind), c.get("frame_step", 1)))
+
+
 def chunks(c, scene, kind):
-    """Frame ranges (first, last) of one sequence's jobs."""
-    n, k = frame_count(c, scene, kind), max(1, c["chunk"])
-    return [(a, min(a + k - 1, n - 1)) for a in range(0, n, k)]
+    """Frame ranges (first, last) of one sequence's jobs, `chunk` evaluated frames each."""
+    f, k = frames_evaluated(c, scene, kind), max(1, c["chunk"])
+    return [(f[i], f[min(i + k, len(f)) - 1]) for i in range(0, len(f), k)]
 
 
 def fit_command(c, scene, name, threads):
     """`latentpt fit` of one ablation fit; --resume continues a killed one from its checkpoint."""
     terms, extra, refine, lr = FITS[name]
-    its, res = c["fit_iterations"], c["image_res"]
+    its, res = c["fit_iterations"], image_res_of(c, scene)
     d = os.path.join(scene, "fit_" + name)
     cmd = [c["bin"], "--threads", str(threads), "fit", scene_file(c, scene), "--encode", "--encode-res", f"{res}x{res}",
-           "--ref-spp", str(ref_spp_of(c, scene)), "--iterations", str(its), "--spp", "4", "--lr", str(lr),
+           "--ref-spp", str(training_ref_spp_of(c, scene)), "--reference-cache", os.path.join(scene, "refs"),
+           "--iterations", str(its), "--spp", "4", "--lr", str(lr),
            "--lr-period", str(its), "--final-spp", "64", "--terms", terms, "-q", "--out", d] + extra
     cmd += ["--refiner-iterations", str(c["refiner_iterations"])] if refine else ["--no-refiner"]
     for define in SCENES[scene][1]:
         cmd += ["-D", define]
     return shlex.join(cmd) + f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume)"
+
+
+def training_reference_command(c, scene, threads):
+    """A one-iteration fit without refiner whose job is to trace and encode the training view's
+    reference into <scene>/refs once (its fit folder is scratch)."""
+    cmd = shlex.split(fit_command(c, scene, "e", threads).split(" $(")[0])
+    cmd[cmd.index("--iterations") + 1] = "1"
+    cmd[cmd.index("--final-spp") + 1] = "1"
+    cmd[cmd.index("--out") + 1] = os.path.join(scene, "refs", "training_fit")
+    return shlex.join(cmd)
 
 
 def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
@@ -237,7 +292,7 @@ def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
            "--reference", "--ref-spp", str(ref_spp_of(c, scene)), "--reference-cache", os.path.join(scene, "refs"),
            "--spp", str(spp), "-q", "--resume", "--out", out]
     if frames:
-        cmd += ["--frames", f"{frames[0]}:{frames[1]}"]
+        cmd += ["--frames", f"{frames[0]}:{frames[1]}:{c.get('frame_step', 1)}"]
     return shlex.join(cmd)
 
 
@@ -276,11 +331,12 @@ def merge_metrics(parts, out):
 def sequence_table(rows):
     """Per config: mean metrics and per-frame curves of one edit sequence."""
     table = {}
-    for key, _ in CONFIGS:
+    for key, _ in [(k, lab) for k, lab in CONFIGS if k.split("+")[0] in rows]:
         src, pre = (rows[key[:-len("+refiner")]], "refined_") if key.endswith("+refiner") else (rows[key], "")
         table[key] = {m: mean(src, pre + m) for m in ("rgb_lpips", "rgb_mse_x100", "latent_dssim", "latent_mse")}
         table[key]["per_frame_lpips"] = [float(r[pre + "rgb_lpips"] or "nan") for r in src]
         table[key]["per_frame_dssim"] = [float(r[pre + "latent_dssim"] or "nan") for r in src]
+        table[key]["frames"] = [int(r["frame"]) for r in src]
     return table
 
 
@@ -301,7 +357,7 @@ def scene_summary(c, out, scene, failures):
     if r_l is not None and f_l is not None and f_l > r_l * 1.0001:
         failures.append(f"{scene}: refiner worse than the rendered latent on the training view (LPIPS {f_l:.4f} > {r_l:.4f})")
     for kind in KINDS:
-        table = sequence_table({name: read_metrics(os.path.join(d, f"{kind}_{name}", "metrics.csv")) for name in FITS})
+        table = sequence_table({name: read_metrics(os.path.join(d, f"{kind}_{name}", "metrics.csv")) for name in fits_of(c)})
         s["edits"][kind] = table
         base = table["e"]["rgb_lpips"]
         for key in ("ea", "eac"):
