@@ -162,6 +162,15 @@ EditSequence load_edits(const std::string& path, const Scene& scene) {
     return seq;
 }
 
+bool is_unedited(const EditSequence& edits, float t) {
+    for (const ShapeEdit& e : edits.shapes)
+        if (e.translate.at(t) != Vec3f::Zero() || e.scale.at(t) != Vec3f::Ones() || e.rotate_angle.at(t).x() != 0.f)
+            return false;
+    const CameraEdit& c = edits.camera;
+    if (c.kind == CameraEdit::Kind::LookAt) return false;
+    return c.kind == CameraEdit::Kind::None || (c.azimuth.at(t).x() == 0.f && c.elevation.at(t).x() == 0.f);
+}
+
 void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original,
                  const Camera& original_camera, Scene& scene) {
     for (size_t i = 0; i < scene.shapes.size(); ++i) scene.shapes[i].mesh = original[i];

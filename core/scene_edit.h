@@ -39,6 +39,11 @@ struct EditSequence {
 /// Parses `path` against `scene` (shape ids must exist). Throws SceneError(path, field, ...).
 EditSequence load_edits(const std::string& path, const Scene& scene);
 
+/// Whether the sequence at time t leaves the scene as loaded: every shape track at its identity
+/// (no translation, unit scale, no rotation) and the orbit's angles 0; a look-at camera always
+/// counts as an edit. Such a frame is the unedited view (an experiment's training view).
+bool is_unedited(const EditSequence& edits, float t);
+
 /// Applies the sequence at time t to `scene`, whose shapes' meshes are reset from `original`
 /// first (so frames do not accumulate), then rebuilds the BVH and light sampler.
 void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original,

@@ -91,16 +91,19 @@ std::string frame_metrics(const std::vector<float>& latent, const std::vector<fl
 
 /// The encoded reference of the edited frame and its display RGB. The edited scene file is not on
 /// disk: path trace this Scene directly, or take the frame from the cache (experiments compare
-/// several fits on one sequence).
+/// several fits on one sequence). An unedited frame (without -D overrides) is the training view: it is cached under the
+/// key `fit --reference-cache` uses, so every sequence's unedited frames and the fits share one
+/// trace.
 std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, const Tools& t, const std::string& frame,
-                                   const std::string& stem, int w, int h, std::vector<float>& ref_rgb) {
+                                   bool unedited, const std::string& stem, int w, int h, std::vector<float>& ref_rgb) {
     std::string cached;
-    if (!job.reference_cache.empty()) {
-        char key[160];
-        std::snprintf(key, sizeof key, "%s_%dx%d_%dspp_%s_%s", fs::path(job.edits).stem().string().c_str(), 8 * w,
-                      8 * h, job.ref_spp, fit.ref_tone.c_str(), frame.c_str());
-        cached = (fs::path(job.reference_cache) / key).string();
-    }
+    if (!job.reference_cache.empty())
+        cached = (fs::path(job.reference_cache) /
+                  (unedited ? training_reference_key(8 * w, 8 * h, job.ref_spp, fit.ref_tone)
+                            : fs::path(job.edits).stem().string() + "_" + std::to_string(8 * w) + "x" +
+                                  std::to_string(8 * h) + "_" + std::to_string(job.ref_spp) + "spp_" + fit.ref_tone +
+                                  "_" + frame))
+                     .string();
     return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae, cached,
                                     stem + "_reference.png", ref_rgb);
 }
@@ -127,7 +130,8 @@ std::string render_frame(const EditJob& job, EditSession& session, const Tools& 
     }
     if (!job.reference) return {};
     std::vector<float> ref_rgb;
-    const std::vector<float> ref = frame_reference(job, session.fit(), t, name, stem, w, h, ref_rgb);
+    const std::vector<float> ref =
+        frame_reference(job, session.fit(), t, name, session.unedited(i) && job.defines.empty(), stem, w, h, ref_rgb);
     std::ostringstream row;
     row << i << "," << session.time(i) << frame_metrics(latent, ref, ref_rgb, w, h, t);
     if (refiner) row << frame_metrics(refined, ref, ref_rgb, w, h, t);

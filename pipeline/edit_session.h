@@ -35,6 +35,8 @@ public:
     /// Frame i as `render --edit --seed seed` renders it (0 = the fit's latent resolution): the
     /// scene is edited to time(i) and rendered with seed + i, so a frame depends on i alone.
     FrameLatents frame(int i, int spp = 64, uint64_t seed = 0, int width = 0, int height = 0);
+    /// Whether frame i is the scene as fitted (core/scene_edit.h is_unedited).
+    bool unedited(int i) const { return is_unedited(m_edits, time(i)); }
     /// The fit, its scene as the last frame() left it (for path-traced references of that frame).
     const FitFolder& fit() const { return m_fit; }
 

@@ -42,6 +42,11 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
     return vae.encode(rgb, width, height);
 }
 
+std::string training_reference_key(int width, int height, int spp, const std::string& tone) {
+    return "training_" + std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) + "spp_" +
+           tone;
+}
+
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, const std::string& tone,
                                             const Vae& vae, const std::string& cache_stem, const std::string& save_png,
                                             std::vector<float>& display_rgb, const Reporter& report) {

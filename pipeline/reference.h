@@ -22,6 +22,10 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
                                         const Vae& vae, const std::string& save_png,
                                         std::vector<float>* display_rgb = nullptr, const Reporter& report = {});
 
+/// The cache name of a view's training reference ("training_<W>x<H>_<spp>spp_<tone>"): fits
+/// and the unedited frames of edit sequences share it.
+std::string training_reference_key(int width, int height, int spp, const std::string& tone);
+
 /// encoded_reference_of through a cache: `cache_stem`.exr holds the display RGB and
 /// `cache_stem`_latent.exr its encoding. A cached reference is read (and re-encoded only when its
 /// latent file is missing); a missing one is traced and both files written, latent first, each

@@ -114,6 +114,12 @@ if [ -d "$shared/models/taesd3" ]; then
     check cmp "$out/enc/target.exr" "$out/encc1/target.exr"
     check cmp "$out/enc/target.exr" "$out/encc2/target.exr"
     check cmp "$out/enc/reference_rgb.exr" "$out/encc2/reference_rgb.exr"
+    # An unedited frame is the training view: its reference is the fits' (same cache key), not a new trace.
+    printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0]]}]}' > "$out/move0.json"
+    "$bin" render "$out/encc1" --edit "$out/move0.json" --reference --ref-spp 4 --spp 2 -q --reference-cache "$out/trefs" --out "$out/edt"
+    check test "$(ls "$out/trefs" | grep -c frame_0000)" -eq 0
+    check test "$(ls "$out/trefs" | grep -c frame_0001)" -eq 2
+    check cmp "$out/encc1/reference.png" "$out/edt/frame_0000_reference.png"
     # An identity edit reproduces the fit's final latent and refined latent exactly (same seed and spp).
     printf '{"frames": 1}' > "$out/identity.json"
     "$bin" render "$out/enc" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed"

@@ -91,3 +91,24 @@ TEST(SceneEdit, ErrorsNameFileAndField) {
     EXPECT_NE(edit_error(s, R"({"camera": {"zoom": 2}})").find("camera"), std::string::npos);
     EXPECT_NE(edit_error(s, R"({"frames": )").find("malformed"), std::string::npos);
 }
+
+TEST(SceneEdit, UneditedOnlyWhereEveryTrackIsItsIdentity) {
+    Scene s = cornell();
+    EditSequence e = load_edits(test::write_temp_file("e3.json", R"({"frames": 4, "shapes": [
+        {"id": "light", "translate": [[0, 0, 0], [1, 0, 0], [0, 0, 0]]},
+        {"id": "tall_block", "scale": [[1, 1, 1], [2, 2, 2], [1, 1, 1]]}],
+        "camera": {"orbit": {"azimuth": [0, 30, 0], "pivot": [2.78, 2.73, 2.8]}}})"),
+                                s);
+    EXPECT_TRUE(is_unedited(e, 0.f));
+    EXPECT_FALSE(is_unedited(e, 0.25f));
+    EXPECT_TRUE(is_unedited(e, 1.f));
+    e.shapes[1].scale = Track{{Vec3f(1, 1, 1.5f)}};
+    EXPECT_FALSE(is_unedited(e, 0.f));  // a constant scale edits every frame
+    e.shapes.clear();
+    e.camera.elevation = Track{{Vec3f(5, 0, 0)}};
+    EXPECT_FALSE(is_unedited(e, 0.f));
+    e.camera.kind = CameraEdit::Kind::LookAt;  // a look-at camera is never the loaded one
+    e.camera.elevation = Track{{Vec3f::Zero()}};
+    EXPECT_FALSE(is_unedited(e, 0.f));
+    EXPECT_TRUE(is_unedited(EditSequence{}, 0.5f));
+}
