@@ -3,7 +3,6 @@
 #include "pipeline/fit_folder.h"
 #include "core/scene.h"
 #include "integrators/path.h"
-#include "latent/latent.h"
 #include "vae/vae.h"
 #include <algorithm>
 #include <cmath>
@@ -54,20 +53,23 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
     if (cache_stem.empty())
         return encoded_reference_of(scene, width, height, spp, tone, vae, save_png, &display_rgb, report);
     const std::string rgb_file = cache_stem + ".exr", latent_file = cache_stem + "_latent.exr";
-    const int f = vae.convention().downsample;
+    const int f = vae.convention().downsample, channels = vae.convention().channels;
+    const auto write_latent_file = [&](const std::vector<float>& latent) {
+        write_exr(latent_file, Image{width / f, height / f, channels, latent, {}});
+    };
     if (!fs::exists(rgb_file)) {
         std::vector<float> latent =
             encoded_reference_of(scene, width, height, spp, tone, vae, save_png, &display_rgb, report);
         fs::create_directories(fs::path(cache_stem).parent_path());
-        write_latent(latent_file, width / f, height / f, latent);
+        write_latent_file(latent);
         write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}});
         return latent;
     }
     display_rgb = read_fit_image(rgb_file, 3, width, height).data;
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});
-    if (fs::exists(latent_file)) return read_fit_image(latent_file, kLatentChannels, width / f, height / f).data;
+    if (fs::exists(latent_file)) return read_fit_image(latent_file, channels, width / f, height / f).data;
     std::vector<float> latent = vae.encode(display_rgb, width, height);
-    write_latent(latent_file, width / f, height / f, latent);
+    write_latent_file(latent);
     return latent;
 }
 
