@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Refiner variants judged by edited views (issue 16, docs/results.md "Refiner study").
+
+Every variant retrains the refiner of one stage-1 fit (a copy of the fit folder, the refiner
+removed) with `latentpt refine <options>`, then renders the experiment's edit sequences with it
+against the experiment's path-traced references (read from its reference cache, never traced
+again) and reports the mean refined LPIPS / MSE×100 over the edited frames. Training uses the
+single training view only: no edited frame or its reference ever reaches `refine`. Defaults are
+chosen by the edit means; the training view's numbers are printed beside them, not used.
+
+    python3 scripts/refiner_study.py --scene-dir results-paper/cbox-specular --variants mse_only,whole_view
+
+<scene-dir> is a scene folder of scripts/experiment.py (fit_eac/, refs/, edits-*.json). Results
+go to <scene-dir>/refiner_study/<variant>/ and study.md / study.json there; finished variants
+and frames are kept (run again to continue).
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import experiment_lib as X  # noqa: E402
+
+# name -> (what it tests, `latentpt refine` options, drop the path-traced RGB so that LPIPS
+# compares with the decoded target as in the paper's loss)
+VARIANTS = {
+    "default": ("our mix (MSE + D-SSIM + LPIPS), 32² crops, lr 5e-4", [], False),
+    "mse_only": ("the paper code's latent MSE alone", ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False),
+    "lpips_to_target": ("LPIPS against dec(target), the paper's loss, not the path-traced RGB", [], True),
+    "whole_view": ("whole-view training (InstanceNorm statistics as at inference)", ["--crop", "0", "--lpips-crop", "32"], False),
+    "lr_1e-4": ("the paper's learning rate 1e-4", ["--lr", "1e-4"], False),
+    "mse_x10": ("latent MSE weighted 10", ["--w-mse", "10"], False),
+    "expansion_8": ("half the width (expansion 8)", ["--expansion", "8"], False),
+    "no_dropout": ("dropout 0", ["--dropout", "0"], False),
+}
+
+
+def run(cmd, log):
+    with open(log, "a") as f:
+        f.write("$ " + " ".join(cmd) + "\n")
+        f.flush()
+        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
+    if r.returncode != 0:
+        sys.exit(f"refiner_study: command failed (exit {r.returncode}), see {log}: {' '.join(cmd)}")
+
+
+def train_variant(a, name, vdir):
+    """A copy of the stage-1 fit with its refiner retrained by the variant's options."""
+    _, opts, drop_rgb = VARIANTS[name]
+    if os.path.exists(os.path.join(vdir, "refine.done")):
+        return
+    if not os.path.isdir(vdir):
+        tmp = vdir + ".tmp"
+        shutil.rmtree(tmp, ignore_errors=True)
+        shutil.copytree(a.fit, tmp, ignore=shutil.ignore_patterns("refiner*.pt", "checkpoint"))
+        if drop_rgb:
+            os.remove(os.path.join(tmp, "reference_rgb.exr"))
+        os.replace(tmp, vdir)
+    resume = ["--resume"] if os.path.exists(os.path.join(vdir, "refiner_checkpoint.pt")) else []
+    run([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(a.iterations), "--seed", "0", "-q"] +
+        opts + resume, os.path.join(vdir, "study.log"))
+    open(os.path.join(vdir, "refine.done"), "w").close()
+
+
+def evaluate(a, vdir, kind):
+    """Mean refined metrics of one edit sequence (the evaluated frames) rendered by the variant."""
+    out = os.path.join(vdir, "edit_" + kind)
+    first, last, step = (int(x) for x in a.frames.split(":"))
+    run([a.bin, "--threads", str(a.threads), "render", vdir, "--edit", os.path.join(a.scene_dir, f"edits-{kind}.json"),
+         "--reference", "--ref-spp", str(a.ref_spp), "--reference-cache", os.path.join(a.scene_dir, "refs"),
+         "--spp", str(a.spp), "--frames", a.frames, "--resume", "-q", "--out", out], os.path.join(vdir, "study.log"))
+    rows = X.read_metrics(os.path.join(out, f"metrics_{first}-{last}.csv"))
+    edited = [r for r in rows if int(r["frame"]) != 0]
+    return {"lpips": X.mean(rows, "refined_rgb_lpips"), "mse_x100": X.mean(rows, "refined_rgb_mse_x100"),
+            "edited_lpips": X.mean(edited, "refined_rgb_lpips"), "edited_mse_x100": X.mean(edited, "refined_rgb_mse_x100"),
+            "frames": [int(r["frame"]) for r in rows]}
+
+
+def training_view(vdir):
+    with open(os.path.join(vdir, "metrics.json")) as f:
+        m = json.load(f)
+    return {"lpips": m["refined"].get("rgb_lpips"), "mse_x100": m["refined"].get("rgb_mse_x100"),
+            "reference": m.get("reference", "")}
+
+
+def report(a, results):
+    md = [f"# Refiner study on {a.scene_dir}", "",
+          f"Stage-1 fit {a.fit}; refiner {a.iterations} iterations; frames {a.frames} of each edit sequence at {a.spp} spp "
+          f"against {a.ref_spp}-spp references. Mean refined LPIPS / MSE×100 (edit columns include frame 0, the "
+          "training view, as the paper's means do; 'edited' excludes it). Choose by the edit means.", "",
+          "| variant | what | " + " | ".join(a.kinds) + " | edited mean | training view |",
+          "|---|---|" + "---|" * (len(a.kinds) + 2)]
+    for name, r in results.items():
+        cells = [f"{r[k]['lpips']:.4f} / {r[k]['mse_x100']:.4f}" for k in a.kinds]
+        el = sum(r[k]["edited_lpips"] for k in a.kinds) / len(a.kinds)
+        em = sum(r[k]["edited_mse_x100"] for k in a.kinds) / len(a.kinds)
+        t = r["training_view"]
+        md.append(f"| {name} | {VARIANTS[name][0]} | " + " | ".join(cells) + f" | {el:.4f} / {em:.4f} | "
+                  f"{t['lpips']:.4f} / {t['mse_x100']:.4f} |")
+    out = os.path.join(a.scene_dir, "refiner_study")
+    X.write_atomic(os.path.join(out, "study.md"), "\n".join(md) + "\n")
+    X.write_atomic(os.path.join(out, "study.json"), json.dumps(results, indent=1))
+    print("\n".join(md))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scene-dir", required=True, help="a scene folder of an experiment run")
+    ap.add_argument("--fit", default=None, help="stage-1 fit folder to copy (default: <scene-dir>/fit_eac)")
+    ap.add_argument("--variants", default="default,mse_only", help="comma-separated: " + ", ".join(VARIANTS))
+    ap.add_argument("--kinds", default="camera,light,object")
+    ap.add_argument("--frames", default="0:54:6", help="A:B:S, as the experiment evaluated them")
+    ap.add_argument("--iterations", type=int, default=1000)
+    ap.add_argument("--ref-spp", type=int, default=128, help="the experiment's reference spp (the cache key)")
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--threads", type=int, default=os.cpu_count())
+    ap.add_argument("--bin", default=os.path.join(X.ROOT, "build", "apps", "latentpt"))
+    a = ap.parse_args()
+    a.fit = a.fit or os.path.join(a.scene_dir, "fit_eac")
+    a.kinds = a.kinds.split(",")
+    if len(a.frames.split(":")) != 3:
+        sys.exit("refiner_study: --frames expects A:B:S")
+    for name in a.variants.split(","):
+        if name not in VARIANTS:
+            sys.exit(f"refiner_study: unknown variant '{name}' (have {', '.join(VARIANTS)})")
+    results = {}
+    for name in a.variants.split(","):
+        vdir = os.path.join(a.scene_dir, "refiner_study", name)
+        train_variant(a, name, vdir)
+        results[name] = {k: evaluate(a, vdir, k) for k in a.kinds}
+        results[name]["training_view"] = training_view(vdir)
+        report(a, results)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
