@@ -145,7 +145,8 @@ def write_outputs(out, c, summary, failures, timings):
                "baseline+refiner": "#e377c2"}
     configs, step = configs_of(c), c.get("frame_step", 1)
     md = ["# latentpt experiment summary", "",
-          f"settings: image {image_res}² (latents {image_res // 8}²) unless said per scene, reference spp per scene below, "
+          f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
+          "reference spp per scene below, "
           f"stage 1 {fit_its} iterations, refiner {ref_its} iterations, frames {frames or 'as in the edit files'}"
           f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp", ""]
     for scene, s in summary.items():
