@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string>
 #include <limits>
 
 namespace lpt::app {
@@ -46,6 +47,16 @@ double time_to(const std::vector<Point>& pts, double threshold, bool latent_erro
     return std::numeric_limits<double>::quiet_NaN();
 }
 
+/// "latent is 6.60x faster" (or slower), or which side never reached the threshold: no ratio then.
+std::string verdict(double latent_s, double rgb_s) {
+    if (std::isnan(latent_s)) return "the latent side did not reach it (no ratio)";
+    if (std::isnan(rgb_s)) return "the RGB side did not reach it within its spp range (no ratio)";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "latent is %.2fx %s", rgb_s >= latent_s ? rgb_s / latent_s : latent_s / rgb_s,
+                  rgb_s >= latent_s ? "faster" : "slower");
+    return buf;
+}
+
 /// Time for each side to reach the latent renderer's error floor × 1.05, in latent and image space.
 void print_equal_error(const std::vector<Point>& lat, const std::vector<Point>& rgb) {
     double best_latent = 1e300, best_rgb = 1e300;
@@ -54,13 +65,10 @@ void print_equal_error(const std::vector<Point>& lat, const std::vector<Point>& 
     const double tl = 1.05 * best_latent, tr = 1.05 * best_rgb;
     const double lat_l = time_to(lat, tl, true, false), rgb_l = time_to(rgb, tl, true, true);
     const double lat_r = time_to(lat, tr, false, true), rgb_r = time_to(rgb, tr, false, false);
-    std::printf(
-        "\nlatent space, MSE <= %.5f: latent renderer %.4f s, RGB path tracing + encode %.4f s -> latent is %.1fx "
-        "faster\n",
-        tl, lat_l, rgb_l, rgb_l / lat_l);
-    std::printf(
-        "image space,  MSE <= %.6f: latent render + decode %.4f s, RGB path tracing %.4f s -> latent is %.2fx %s\n", tr,
-        lat_r, rgb_r, rgb_r >= lat_r ? rgb_r / lat_r : lat_r / rgb_r, rgb_r >= lat_r ? "faster" : "slower");
+    std::printf("\nlatent space, MSE <= %.5f: latent renderer %.4f s, RGB path tracing + encode %.4f s -> %s\n", tl,
+                lat_l, rgb_l, verdict(lat_l, rgb_l).c_str());
+    std::printf("image space,  MSE <= %.6f: latent render + decode %.4f s, RGB path tracing %.4f s -> %s\n", tr, lat_r,
+                rgb_r, verdict(lat_r, rgb_r).c_str());
     std::printf(
         "(NaN: not reached within the spp range; the thresholds are the latent renderer's error floor x 1.05)\n");
 }
