@@ -18,8 +18,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <string>
 #include <limits>
+#include <string>
 
 namespace lpt::app {
 

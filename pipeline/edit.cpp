@@ -91,9 +91,9 @@ std::string frame_metrics(const std::vector<float>& latent, const std::vector<fl
 
 /// The encoded reference of the edited frame and its display RGB. The edited scene file is not on
 /// disk: path trace this Scene directly, or take the frame from the cache (experiments compare
-/// several fits on one sequence). An unedited frame (without -D overrides) is the training view: it is cached under the
-/// key `fit --reference-cache` uses, so every sequence's unedited frames and the fits share one
-/// trace.
+/// several fits on one sequence). An unedited frame (without -D overrides) is the training view:
+/// it is cached under the key `fit --reference-cache` uses, so every sequence's unedited frames
+/// and the fits share one trace.
 std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, const Tools& t, const std::string& frame,
                                    bool unedited, const std::string& stem, int w, int h, std::vector<float>& ref_rgb) {
     std::string cached;

@@ -288,9 +288,13 @@ def fits_of(c):
     return c.get("fits", list(FITS))
 
 
+def configs_for(fits):
+    """The table's columns for these fits: CONFIGS whose fit is among them."""
+    return [(k, lab) for k, lab in CONFIGS if k.split("+")[0] in fits]
+
+
 def configs_of(c):
-    """The table's columns of this run: CONFIGS whose fit ran."""
-    return [(k, lab) for k, lab in CONFIGS if k.split("+")[0] in fits_of(c)]
+    return configs_for(fits_of(c))
 
 
 def scene_file(c, scene):
@@ -319,29 +323,30 @@ def chunks(c, scene, kind):
     return [(f[i], f[min(i + k, len(f)) - 1]) for i in range(0, len(f), k)]
 
 
-def fit_command(c, scene, name, threads):
-    """`latentpt fit` of one ablation fit; --resume continues a killed one from its checkpoint."""
+def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64):
+    """`latentpt fit` arguments of one ablation fit into `out` (iterations: the config's)."""
     terms, extra, refine, lr = FITS[name]
     its, res = c["fit_iterations"], image_res_of(c, scene)
-    d = os.path.join(scene, "fit_" + name)
     cmd = [c["bin"], "--threads", str(threads), "fit", scene_file(c, scene), "--encode", "--encode-res", f"{res}x{res}",
            "--ref-spp", str(training_ref_spp_of(c, scene)), "--reference-cache", os.path.join(scene, "refs"),
-           "--iterations", str(its), "--spp", "4", "--lr", str(lr),
-           "--lr-period", str(its), "--final-spp", "64", "--terms", terms, "-q", "--out", d] + extra
+           "--iterations", str(iterations or its), "--spp", "4", "--lr", str(lr),
+           "--lr-period", str(its), "--final-spp", str(final_spp), "--terms", terms, "-q", "--out", out] + extra
     cmd += ["--refiner-iterations", str(c["refiner_iterations"])] if refine else ["--no-refiner"]
     for define in SCENES[scene][1]:
         cmd += ["-D", define]
-    return shlex.join(cmd) + f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume)"
+    return cmd
+
+
+def fit_command(c, scene, name, threads):
+    """`latentpt fit` of one ablation fit; --resume continues a killed one from its checkpoint."""
+    d = os.path.join(scene, "fit_" + name)
+    return shlex.join(fit_argv(c, scene, name, threads, d)) + f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume)"
 
 
 def training_reference_command(c, scene, threads):
     """A one-iteration fit without refiner whose job is to trace and encode the training view's
     reference into <scene>/refs once (its fit folder is scratch)."""
-    cmd = shlex.split(fit_command(c, scene, "e", threads).split(" $(")[0])
-    cmd[cmd.index("--iterations") + 1] = "1"
-    cmd[cmd.index("--final-spp") + 1] = "1"
-    cmd[cmd.index("--out") + 1] = os.path.join(scene, "refs", "training_fit")
-    return shlex.join(cmd)
+    return shlex.join(fit_argv(c, scene, "e", threads, os.path.join(scene, "refs", "training_fit"), iterations=1, final_spp=1))
 
 
 def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
@@ -389,7 +394,7 @@ def merge_metrics(parts, out):
 def sequence_table(rows):
     """Per config: mean metrics and per-frame curves of one edit sequence."""
     table = {}
-    for key, _ in [(k, lab) for k, lab in CONFIGS if k.split("+")[0] in rows]:
+    for key, _ in configs_for(rows):
         src, pre = (rows[key[:-len("+refiner")]], "refined_") if key.endswith("+refiner") else (rows[key], "")
         table[key] = {m: mean(src, pre + m) for m in ("rgb_lpips", "rgb_mse_x100", "latent_dssim", "latent_mse")}
         table[key]["per_frame_lpips"] = [float(r[pre + "rgb_lpips"] or "nan") for r in src]
