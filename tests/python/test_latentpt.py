@@ -155,6 +155,35 @@ class GuidanceTest(unittest.TestCase):
                                        f"{moved[~own].mean():.4f}")
 
 
+class GateCoverageTest(unittest.TestCase):
+    """scripts/gate_coverage.py measures Ĩc's gate through the linear terms alone."""
+
+    def test_shadowed_and_visible_gates_split_every_shape_and_the_ceiling_never_sees_the_light(self):
+        import importlib.util
+        spec = importlib.util.spec_from_file_location("gate_coverage", os.path.join(SRC, "scripts", "gate_coverage.py"))
+        gc = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(gc)
+        scene = latentpt.Scene(BOX, defines={"camera.width": "64", "camera.height": "64"})
+        cover = {gate: gc.gate_coverage(latentpt.LatentScene(scene, seed=1, gate=gate), spp=2, seed=4)
+                 for gate in ("shadowed", "visible")}
+        gc.GROUP = 3  # shapes in groups of 3: the same paths, the same numbers
+        grouped = gc.gate_coverage(latentpt.LatentScene(scene, seed=1, gate="shadowed"), spp=2, seed=4)
+        for shape, (share, shadowed) in grouped.items():
+            self.assertAlmostEqual(share, cover["shadowed"][shape][0], places=6, msg=shape)
+            self.assertAlmostEqual(shadowed, cover["shadowed"][shape][1], places=6, msg=shape)
+        self.assertEqual(set(cover["shadowed"]), {"floor", "ceiling", "back", "green_wall", "red_wall", "short_block",
+                                                  "tall_block", "light"})
+        for shape, (share, shadowed) in cover["shadowed"].items():
+            # Same paths, complementary gates: every first vertex is counted by exactly one.
+            self.assertAlmostEqual(shadowed + cover["visible"][shape][1], 1.0, places=5, msg=shape)
+            self.assertAlmostEqual(share, cover["visible"][shape][0], places=6, msg=shape)
+        # The light faces down from the ceiling: every ceiling sample lies on its back side.
+        self.assertAlmostEqual(cover["shadowed"]["ceiling"][1], 1.0, places=6)
+        self.assertLess(cover["shadowed"]["back"][1], 0.5)  # mostly lit; the blocks shadow a part
+        self.assertGreater(cover["shadowed"]["back"][1], 0.0)
+        self.assertAlmostEqual(sum(share for share, _ in cover["shadowed"].values()), 1.0, places=6)
+
+
 class PipelineTest(unittest.TestCase):
     def test_fit_reports_progress_and_cancels_cleanly(self):
         with tempfile.TemporaryDirectory() as d:
