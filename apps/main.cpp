@@ -63,9 +63,9 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
     sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")
         ->capture_default_str()
         ->check(positive());
-    sc->add_option("--" + pre + "patience", ra.train.patience,
-                   "refiner early stopping on the smoothed loss->check(non_negative()); 0 = off")
-        ->capture_default_str();
+    sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")
+        ->capture_default_str()
+        ->check(non_negative());
     sc->add_option("--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE")
         ->capture_default_str()
         ->check(non_negative());
@@ -78,6 +78,11 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
     sc->add_option("--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)")
         ->capture_default_str()
         ->check(positive());
+    sc->add_option_function<std::string>(
+          "--" + pre + "norm", [&ra](const std::string& v) { ra.net.instance_norm = v == "instance"; },
+          "normalisation after each convolution: instance (ours) or none (the paper's network)")
+        ->check(CLI::IsMember({"instance", "none"}))
+        ->default_str(ra.net.instance_norm ? "instance" : "none");
     sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.99));

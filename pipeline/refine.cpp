@@ -81,6 +81,7 @@ std::string refiner_csv(const RefinerTrainResult& res) {
 nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, const RefinerTrainResult& res) {
     const double seconds = res.history.empty() ? 0.0 : res.history.back().seconds;
     return {{"expansion", job.net.expansion},
+            {"norm", refiner.config().instance_norm ? "instance" : "none"},
             {"parameters", refiner.parameter_count()},
             {"iterations", res.history.size()},
             {"best_iteration", res.best_iteration},

@@ -11,7 +11,7 @@ namespace lpt::pipeline {
 
 struct RefineJob {
     std::string fitdir;
-    RefinerConfig net;          ///< expansion, squash, dropout (distance_scale comes from the view)
+    RefinerConfig net;          ///< expansion, squash, dropout, norm (distance_scale comes from the view)
     RefinerTrainOptions train;  ///< iterations, lr, loss weights, crops, patience, seed, checkpoint_every
     bool resume = false;        ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
     std::string lpips_dir;      ///< empty = ../shared/models/lpips

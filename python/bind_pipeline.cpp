@@ -38,6 +38,12 @@ pipeline::Reporter reporter(const py::object& progress, const py::object& note) 
 }
 
 /// Sets the job fields named in `options` (the CLI's option names with underscores).
+/// refiner_norm="instance" | "none", as --refiner-norm.
+bool norm_option(const std::string& v) {
+    if (v != "instance" && v != "none") throw py::value_error("fit(): refiner_norm must be 'instance' or 'none'");
+    return v == "instance";
+}
+
 void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
     for (const auto& [key, value] : options) {
         const std::string k = py::str(key);
@@ -65,6 +71,7 @@ void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
         else if (k == "refiner") job.refiner = value.cast<bool>();
         else if (k == "refiner_iterations") job.refine.train.iterations = value.cast<int>();
         else if (k == "refiner_expansion") job.refine.net.expansion = value.cast<int>();
+        else if (k == "refiner_norm") job.refine.net.instance_norm = norm_option(value.cast<std::string>());
         else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
         else throw py::type_error("fit() got an unknown option '" + k + "'");
     }

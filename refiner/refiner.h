@@ -21,6 +21,10 @@ struct RefinerConfig {
     float squash = 3.f;  ///< inputs enter as tanh(x / squash); 3 = the TAESD decoder's soft clamp
     float dropout = 0.1f;
     float distance_scale = 1.f;  ///< distances are divided by this (the training view's mean hit distance)
+    /// InstanceNorm after each convolution (ours). false: none, as the paper describes its network;
+    /// then a pixel's output depends only on its 9×9 neighbourhood, not on the statistics of the
+    /// crop or view around it (except within 4 pixels of an edge, where padding stands in).
+    bool instance_norm = true;
 };
 
 /// What the refiner reads for one view: the rendered (tone-mapped) latent and its AOVs.

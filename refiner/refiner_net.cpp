@@ -31,17 +31,20 @@ RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
     auto norm = [&](const char* name) {
         return register_module(name, torch::nn::InstanceNorm2d(torch::nn::InstanceNorm2dOptions(width).affine(true)));
     };
-    n1 = norm("n1");
-    n2 = norm("n2");
-    n3 = norm("n3");
+    if (config.instance_norm) {
+        n1 = norm("n1");
+        n2 = norm("n2");
+        n3 = norm("n3");
+    }
     drop = register_module("drop", torch::nn::Dropout(torch::nn::DropoutOptions(config.dropout)));
 }
 
 torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x) {
+    auto norm = [](torch::nn::InstanceNorm2d& n, const torch::Tensor& t) { return n.is_empty() ? t : n(t); };
     torch::Tensor h = torch::tanh(x / cfg.squash);
-    h = drop(torch::relu(n1(c1(h))));
-    h = drop(torch::relu(n2(c2(h))));
-    h = drop(torch::relu(n3(c3(h))));
+    h = drop(torch::relu(norm(n1, c1(h))));
+    h = drop(torch::relu(norm(n2, c2(h))));
+    h = drop(torch::relu(norm(n3, c3(h))));
     return x.narrow(1, 0, cfg.latent_channels) + head(h);
 }
 
@@ -100,6 +103,7 @@ void Refiner::save(const std::string& path) const {
     ar.write("config.squash", c10::IValue(double(c.squash)));
     ar.write("config.dropout", c10::IValue(double(c.dropout)));
     ar.write("config.distance_scale", c10::IValue(double(c.distance_scale)));
+    ar.write("config.instance_norm", c10::IValue(int64_t(c.instance_norm)));
     const std::string tmp = path + ".tmp";
     ar.save_to(tmp);
     std::filesystem::rename(tmp, path);
@@ -123,6 +127,8 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c.squash = float(get("config.squash").toDouble());
         c.dropout = float(get("config.dropout").toDouble());
         c.distance_scale = float(get("config.distance_scale").toDouble());
+        c10::IValue norm;  // absent in files written before the option: they all had InstanceNorm
+        c.instance_norm = !ar.try_read("config.instance_norm", norm) || norm.toInt() != 0;
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
         impl->net->load(ar);
         return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));

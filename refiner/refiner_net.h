@@ -6,8 +6,9 @@
 
 namespace lpt {
 
-/// tanh(x / squash) → [conv k, InstanceNorm, ReLU, Dropout] for k = 3, 5, 3 → 1×1 conv, and
-/// the result is added to the unsquashed latent (the first latent_channels input channels).
+/// tanh(x / squash) → [conv k, InstanceNorm (unless config.instance_norm is false), ReLU, Dropout]
+/// for k = 3, 5, 3 → 1×1 conv, and the result is added to the unsquashed latent (the first
+/// latent_channels input channels).
 struct RefinerNetImpl : torch::nn::Module {
     explicit RefinerNetImpl(const RefinerConfig& config);
     /// x: [N, latent_channels + 4, h, w] (latent, normal xyz, scaled distance) → refined latent.
@@ -15,7 +16,7 @@ struct RefinerNetImpl : torch::nn::Module {
 
     RefinerConfig cfg;
     torch::nn::Conv2d c1{nullptr}, c2{nullptr}, c3{nullptr}, head{nullptr};
-    torch::nn::InstanceNorm2d n1{nullptr}, n2{nullptr}, n3{nullptr};
+    torch::nn::InstanceNorm2d n1{nullptr}, n2{nullptr}, n3{nullptr};  ///< empty without instance_norm
     torch::nn::Dropout drop{nullptr};
 };
 TORCH_MODULE(RefinerNet);

@@ -54,12 +54,26 @@ struct TrainingState {
           best(copy_params(*net)) {}
 };
 
+/// A checkpoint of another network shape cannot continue: say which option differs instead of
+/// letting the weight loader fail on a missing tensor.
+void check_checkpoint_network(const std::string& path, torch::serialize::InputArchive& ar, const RefinerConfig& cfg) {
+    c10::IValue v;
+    const bool norm = !ar.try_read("config.instance_norm", v) || v.toInt() != 0;  // older files: InstanceNorm
+    if (norm != cfg.instance_norm)
+        throw std::runtime_error(path + ": the checkpoint was trained with --norm " + (norm ? "instance" : "none") +
+                                 "; resume with the same --norm, or start again without --resume");
+    if (ar.try_read("config.expansion", v) && v.toInt() != cfg.expansion)
+        throw std::runtime_error(path + ": the checkpoint was trained with --expansion " + std::to_string(v.toInt()) +
+                                 "; resume with the same --expansion");
+}
+
 void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, TrainingState& s) {
     if (path.empty() || !std::filesystem::exists(path))
         throw std::runtime_error("refiner: --resume but no checkpoint at '" + path + "'");
     try {
         torch::serialize::InputArchive ar, net_ar, best_ar, adam_ar;
         ar.load_from(path);
+        check_checkpoint_network(path, ar, cfg);
         ar.read("net", net_ar);
         net->load(net_ar);
         ar.read("best", best_ar);
@@ -98,6 +112,8 @@ void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
 void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, TrainingState& s) {
     if (path.empty()) return;
     torch::serialize::OutputArchive ar, net_ar, best_ar, adam_ar;
+    ar.write("config.instance_norm", c10::IValue(int64_t(cfg.instance_norm)));
+    ar.write("config.expansion", c10::IValue(int64_t(cfg.expansion)));
     net->save(net_ar);
     ar.write("net", net_ar);
     RefinerNet tmp(cfg);

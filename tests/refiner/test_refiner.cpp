@@ -9,6 +9,7 @@
 #include "vae/lpips.h"
 #include "vae/vae.h"
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <limits>
 #include <cmath>
 #include <filesystem>
@@ -62,6 +63,38 @@ RefinerConfig small() {
 }
 
 std::string temp_path(const std::string& name) { return test::write_temp_file(name, ""); }
+
+/// The window [x0, x0 + w) × [y0, y0 + h) of a view.
+RefinerInput crop_of(const RefinerInput& in, int x0, int y0, int w, int h) {
+    RefinerInput c;
+    c.width = w;
+    c.height = h;
+    for (int y = y0; y < y0 + h; ++y)
+        for (int x = x0; x < x0 + w; ++x) {
+            const size_t i = size_t(y) * size_t(in.width) + size_t(x);
+            c.latent.insert(c.latent.end(), in.latent.begin() + long(i * kC), in.latent.begin() + long((i + 1) * kC));
+            c.normal.insert(c.normal.end(), in.normal.begin() + long(i * 3), in.normal.begin() + long((i + 1) * 3));
+            c.distance.push_back(in.distance[i]);
+        }
+    return c;
+}
+
+/// Largest difference between a refined crop and the same pixels of the refined whole view,
+/// over the crop's interior: pixels further than the receptive-field radius (1 + 2 + 1 for the
+/// 3×3, 5×5, 3×3 blocks) from its edges, which see no padding.
+double crop_vs_whole(const Refiner& r, const RefinerInput& in, int x0, int y0, int w, int h) {
+    const std::vector<float> whole = r.refine(in), part = r.refine(crop_of(in, x0, y0, w, h));
+    constexpr int kRadius = 4;
+    double worst = 0;
+    for (int y = kRadius; y < h - kRadius; ++y)
+        for (int x = kRadius; x < w - kRadius; ++x)
+            for (int c = 0; c < kC; ++c) {
+                const size_t a = (size_t(y) * size_t(w) + size_t(x)) * kC + size_t(c);
+                const size_t b = (size_t(y + y0) * size_t(in.width) + size_t(x + x0)) * kC + size_t(c);
+                worst = std::max(worst, double(std::abs(part[a] - whole[b])));
+            }
+    return worst;
+}
 
 }  // namespace
 
@@ -165,6 +198,52 @@ TEST(Refiner, SaveLoadAndResumeReproduceOutputs) {
         EXPECT_NE(std::string(e.what()).find("junk.pt"), std::string::npos) << e.what();
     }
     EXPECT_THROW(Refiner::load(temp_path("missing.pt")), std::runtime_error);
+}
+
+// Without InstanceNorm the refiner is a plain convolution network: a crop's interior is refined
+// exactly as the whole view refines those pixels (its 4-pixel border sees zero padding instead
+// of neighbours). With InstanceNorm (the default) the crop's own statistics change every pixel.
+// The choice survives save/load.
+TEST(Refiner, WithoutInstanceNormACropIsRefinedAsTheWholeView) {
+    Problem p = make_problem(24, 20);
+    RefinerTrainOptions o;
+    o.iterations = 20;
+    o.lr = 3e-3f;
+    o.crop = 12;
+    o.w_lpips = 0.f;
+    o.patience = 0;
+    RefinerConfig cfg = small();
+    cfg.instance_norm = false;
+    auto plain = Refiner::create(cfg, 4);
+    plain->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    auto normed = Refiner::create(small(), 4);
+    normed->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    ASSERT_GT(mse(plain->refine(p.in), p.in.latent), 1e-4) << "training left the refiner the identity";
+
+    EXPECT_LT(crop_vs_whole(*plain, p.in, 5, 3, 14, 12), 1e-5);
+    EXPECT_GT(crop_vs_whole(*normed, p.in, 5, 3, 14, 12), 1e-3);
+    EXPECT_LT(plain->parameter_count(), normed->parameter_count());  // no affine norm weights
+
+    const std::string file = temp_path("plain_refiner.pt");
+    plain->save(file);
+    auto loaded = Refiner::load(file);
+    EXPECT_FALSE(loaded->config().instance_norm);
+    EXPECT_EQ(loaded->refine(p.in), plain->refine(p.in));
+
+    // A checkpoint of the other network cannot be resumed: the error names the option.
+    const std::string ck = temp_path("normed_ck.pt");
+    std::filesystem::remove(ck);
+    o.iterations = 2;
+    o.checkpoint_path = ck;
+    Refiner::create(small(), 4)->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    o.iterations = 4;
+    o.resume = true;
+    try {
+        Refiner::create(cfg, 4)->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+        FAIL() << "an InstanceNorm checkpoint resumed without InstanceNorm";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("--norm instance"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Refiner, LpipsThroughTheDecoderTrains) {
