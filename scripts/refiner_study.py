@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Refiner variants judged by edited views (issue 16, docs/results.md "Refiner study").
 
-Every variant retrains the refiner of one stage-1 fit (a copy of the fit folder, the refiner
-removed) with `latentpt refine <options>`, then renders the experiment's edit sequences with it
+Every variant but 'default' retrains the refiner of one stage-1 fit (a copy of the fit folder,
+the refiner removed) with `latentpt refine <options>`; each then renders the experiment's edit sequences with it
 against the experiment's path-traced references (read from its reference cache, never traced
 again) and reports the mean refined LPIPS / MSE×100 over the edited frames. Training uses the
 single training view only: no edited frame or its reference ever reaches `refine`. Defaults are
@@ -10,9 +10,12 @@ chosen by the edit means; the training view's numbers are printed beside them, n
 
     python3 scripts/refiner_study.py --scene-dir results-paper/cbox-specular --variants mse_only,whole_view
 
-<scene-dir> is a scene folder of scripts/experiment.py (fit_eac/, refs/, edits-*.json). Results
-go to <scene-dir>/refiner_study/<variant>/ and study.md / study.json there; finished variants
-and frames are kept (run again to continue).
+<scene-dir> is a scene folder of scripts/experiment.py (fit_eac/, refs/, edits-*.json). The
+frames, spp and reference spp default to the experiment's (its experiment-config.json beside the
+scene folder), so the references come from its cache. Results go to
+<scene-dir>/refiner_study/<variant>/ and study.md / study.json there; finished variants and
+frames are kept (run again to continue). The 'default' variant is the fit's own refiner, not
+retrained: the experiment's +refiner column, scored again.
 """
 import argparse
 import json
@@ -25,9 +28,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import experiment_lib as X  # noqa: E402
 
 # name -> (what it tests, `latentpt refine` options, drop the path-traced RGB so that LPIPS
-# compares with the decoded target as in the paper's loss)
+# compares with the decoded target as in the paper's loss); None options: keep the fit's refiner
 VARIANTS = {
-    "default": ("our mix (MSE + D-SSIM + LPIPS), 32² crops, lr 5e-4", [], False),
+    "default": ("the fit's refiner: MSE + D-SSIM + LPIPS, 32² crops, InstanceNorm, lr 5e-4", None, False),
+    "no_norm": ("no InstanceNorm (crops and whole views see one function)", ["--norm", "none"], False),
+    "paper": ("the paper's text where it differs: no InstanceNorm, LPIPS to dec(target), lr 1e-4 (crops, dropout, "
+              "iterations ours)", ["--norm", "none", "--lr", "1e-4"], True),
     "mse_only": ("the paper code's latent MSE alone", ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False),
     "lpips_to_target": ("LPIPS against dec(target), the paper's loss, not the path-traced RGB", [], True),
     "whole_view": ("whole-view training (InstanceNorm statistics as at inference)", ["--crop", "0", "--lpips-crop", "32"], False),
@@ -48,21 +54,33 @@ def run(cmd, log):
 
 
 def train_variant(a, name, vdir):
-    """A copy of the stage-1 fit with its refiner retrained by the variant's options."""
+    """A copy of the stage-1 fit with its refiner retrained by the variant's options (kept as is
+    for 'default'). refine.done records what made the folder: a folder made otherwise (another
+    fit, options or iterations) is an error, not silently reused."""
     _, opts, drop_rgb = VARIANTS[name]
-    if os.path.exists(os.path.join(vdir, "refine.done")):
+    stamp = json.dumps({"fit": os.path.abspath(a.fit), "options": opts, "drop_rgb": drop_rgb,
+                        "iterations": None if opts is None else a.iterations})
+    done = os.path.join(vdir, "refine.done")
+    if os.path.exists(done):
+        with open(done) as f:
+            if f.read() != stamp:
+                sys.exit(f"refiner_study: {vdir} was made with other settings ({done}); remove it to redo")
         return
+    if opts is None and not os.path.exists(os.path.join(a.fit, "refiner.pt")):
+        sys.exit(f"refiner_study: {a.fit} has no refiner.pt for the 'default' variant")
     if not os.path.isdir(vdir):
         tmp = vdir + ".tmp"
         shutil.rmtree(tmp, ignore_errors=True)
-        shutil.copytree(a.fit, tmp, ignore=shutil.ignore_patterns("refiner*.pt", "checkpoint"))
+        skip = ["checkpoint", "refiner_checkpoint.pt"] + (["refiner*.pt"] if opts is not None else [])
+        shutil.copytree(a.fit, tmp, ignore=shutil.ignore_patterns(*skip))
         if drop_rgb:
             os.remove(os.path.join(tmp, "reference_rgb.exr"))
         os.replace(tmp, vdir)
-    resume = ["--resume"] if os.path.exists(os.path.join(vdir, "refiner_checkpoint.pt")) else []
-    run([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(a.iterations), "--seed", "0", "-q"] +
-        opts + resume, os.path.join(vdir, "study.log"))
-    open(os.path.join(vdir, "refine.done"), "w").close()
+    if opts is not None:
+        resume = ["--resume"] if os.path.exists(os.path.join(vdir, "refiner_checkpoint.pt")) else []
+        run([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(a.iterations), "--seed", "0",
+             "-q"] + opts + resume, os.path.join(vdir, "study.log"))
+    X.write_atomic(done, stamp)
 
 
 def evaluate(a, vdir, kind):
@@ -88,7 +106,8 @@ def training_view(vdir):
 
 def report(a, results):
     md = [f"# Refiner study on {a.scene_dir}", "",
-          f"Stage-1 fit {a.fit}; refiner {a.iterations} iterations; frames {a.frames} of each edit sequence at {a.spp} spp "
+          f"Stage-1 fit {a.fit}; refiner {a.iterations} iterations (the default variant: the fit's own); "
+          f"frames {a.frames} of each edit sequence at {a.spp} spp "
           f"against {a.ref_spp}-spp references. Mean refined LPIPS / MSE×100 (edit columns include frame 0, the "
           "training view, as the paper's means do; 'edited' excludes it). Choose by the edit means.", "",
           "| variant | what | " + " | ".join(a.kinds) + " | edited mean | training view |",
@@ -106,21 +125,46 @@ def report(a, results):
     print("\n".join(md))
 
 
+def experiment_defaults(a):
+    """Fills the unset --frames, --iterations, --ref-spp and --spp from the experiment's config."""
+    path = os.path.join(os.path.dirname(os.path.abspath(a.scene_dir)), "experiment-config.json")
+    c = None
+    if os.path.exists(path):
+        with open(path) as f:
+            c = json.load(f)
+    scene = os.path.basename(os.path.abspath(a.scene_dir))
+    if c is None or scene not in X.SCENES:
+        if None in (a.frames, a.iterations, a.ref_spp, a.spp):
+            why = f"no experiment config at {path}" if c is None else f"'{scene}' is not an experiment scene"
+            sys.exit(f"refiner_study: {why}; give --frames, --iterations, --ref-spp, --spp")
+        return
+    frames = X.frames_evaluated(c, scene, a.kinds[0])
+    if a.frames is None:
+        a.frames = f"{frames[0]}:{frames[-1]}:{c.get('frame_step', 1)}"
+    if a.iterations is None:
+        a.iterations = c["refiner_iterations"]
+    if a.ref_spp is None:
+        a.ref_spp = X.ref_spp_of(c, scene)
+    if a.spp is None:
+        a.spp = c["spp"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scene-dir", required=True, help="a scene folder of an experiment run")
     ap.add_argument("--fit", default=None, help="stage-1 fit folder to copy (default: <scene-dir>/fit_eac)")
     ap.add_argument("--variants", default="default,mse_only", help="comma-separated: " + ", ".join(VARIANTS))
     ap.add_argument("--kinds", default="camera,light,object")
-    ap.add_argument("--frames", default="0:54:6", help="A:B:S, as the experiment evaluated them")
-    ap.add_argument("--iterations", type=int, default=1000)
-    ap.add_argument("--ref-spp", type=int, default=128, help="the experiment's reference spp (the cache key)")
-    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--frames", default=None, help="A:B:S (default: the frames the experiment evaluated)")
+    ap.add_argument("--iterations", type=int, default=None, help="refiner steps (default: the experiment's)")
+    ap.add_argument("--ref-spp", type=int, default=None, help="reference spp, the cache key (default: the experiment's)")
+    ap.add_argument("--spp", type=int, default=None, help="latent spp (default: the experiment's)")
     ap.add_argument("--threads", type=int, default=os.cpu_count())
     ap.add_argument("--bin", default=os.path.join(X.ROOT, "build", "apps", "latentpt"))
     a = ap.parse_args()
     a.fit = a.fit or os.path.join(a.scene_dir, "fit_eac")
     a.kinds = a.kinds.split(",")
+    experiment_defaults(a)
     if len(a.frames.split(":")) != 3:
         sys.exit("refiner_study: --frames expects A:B:S")
     for name in a.variants.split(","):
