@@ -50,6 +50,10 @@ def snakemake_command(a, config_path, out):
            "--configfile", config_path, "--rerun-incomplete", "--cores", str(a.cores),
            # our own lock (below) replaces Snakemake's, which a killed run leaves behind
            "--nolock"]
+    if not a.slurm:
+        # `run:` jobs (edit files, metric merges, the summary) in threads of this process: as
+        # subprocesses (Snakemake 7's local default) each one starts Python and re-reads the workflow
+        cmd += ["--force-use-threads"]
     if a.slurm:
         # Snakemake's generic cluster mode with our status script: its --slurm executor of 7.21
         # needs $USER and sacct accounting for status, which small clusters often lack.
