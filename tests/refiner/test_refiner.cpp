@@ -64,6 +64,17 @@ RefinerConfig small() {
 
 std::string temp_path(const std::string& name) { return test::write_temp_file(name, ""); }
 
+/// Latent losses only (no decoder), a fast learning rate, no early stopping.
+RefinerTrainOptions latent_training(int iterations, int crop) {
+    RefinerTrainOptions o;
+    o.iterations = iterations;
+    o.lr = 3e-3f;
+    o.crop = crop;
+    o.w_lpips = 0.f;
+    o.patience = 0;
+    return o;
+}
+
 /// The window [x0, x0 + w) × [y0, y0 + h) of a view.
 RefinerInput crop_of(const RefinerInput& in, int x0, int y0, int w, int h) {
     RefinerInput c;
@@ -113,12 +124,7 @@ TEST(Refiner, TrainingLowersTheLossAndKeepsTheBest) {
     Problem p = make_problem(16, 16);
     auto r = Refiner::create(small(), 1);
     const double before = mse(r->refine(p.in), p.target);
-    RefinerTrainOptions o;
-    o.iterations = 150;
-    o.lr = 3e-3f;
-    o.crop = 12;
-    o.w_lpips = 0.f;
-    o.patience = 0;
+    const RefinerTrainOptions o = latent_training(150, 12);
     RefinerTrainResult res = r->train(p.in, p.target, nullptr, nullptr, nullptr, o);
     ASSERT_EQ(res.history.size(), 150u);
     const double after = mse(r->refine(p.in), p.target);
@@ -206,12 +212,7 @@ TEST(Refiner, SaveLoadAndResumeReproduceOutputs) {
 // The choice survives save/load.
 TEST(Refiner, WithoutInstanceNormACropIsRefinedAsTheWholeView) {
     Problem p = make_problem(24, 20);
-    RefinerTrainOptions o;
-    o.iterations = 20;
-    o.lr = 3e-3f;
-    o.crop = 12;
-    o.w_lpips = 0.f;
-    o.patience = 0;
+    RefinerTrainOptions o = latent_training(20, 12);
     RefinerConfig cfg = small();
     cfg.instance_norm = false;
     auto plain = Refiner::create(cfg, 4);
