@@ -37,13 +37,13 @@ pipeline::Reporter reporter(const py::object& progress, const py::object& note) 
     return r;
 }
 
-/// Sets the job fields named in `options` (the CLI's option names with underscores).
 /// refiner_norm="instance" | "none", as --refiner-norm.
 bool norm_option(const std::string& v) {
     if (v != "instance" && v != "none") throw py::value_error("fit(): refiner_norm must be 'instance' or 'none'");
     return v == "instance";
 }
 
+/// Sets the job fields named in `options` (the CLI's option names with underscores).
 void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
     for (const auto& [key, value] : options) {
         const std::string k = py::str(key);

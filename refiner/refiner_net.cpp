@@ -48,6 +48,11 @@ torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x) {
     return x.narrow(1, 0, cfg.latent_channels) + head(h);
 }
 
+bool archived_instance_norm(torch::serialize::InputArchive& ar) {
+    c10::IValue norm;
+    return !ar.try_read("config.instance_norm", norm) || norm.toInt() != 0;
+}
+
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config) {
     const int64_t w = in.width, h = in.height, c = config.latent_channels, n = w * h;
     if (w < 1 || h < 1) throw std::invalid_argument("refiner: empty view");
@@ -127,8 +132,7 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c.squash = float(get("config.squash").toDouble());
         c.dropout = float(get("config.dropout").toDouble());
         c.distance_scale = float(get("config.distance_scale").toDouble());
-        c10::IValue norm;  // absent in files written before the option: they all had InstanceNorm
-        c.instance_norm = !ar.try_read("config.instance_norm", norm) || norm.toInt() != 0;
+        c.instance_norm = archived_instance_norm(ar);
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
         impl->net->load(ar);
         return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));

@@ -28,6 +28,10 @@ struct Refiner::Impl {
 
 constexpr int kRefinerAovChannels = 4;  ///< normal (3) + distance (1)
 
+/// The instance_norm flag stored in a refiner.pt or checkpoint archive; files written before the
+/// option have none and all had InstanceNorm.
+bool archived_instance_norm(torch::serialize::InputArchive& ar);
+
 /// The network input [1, C + 4, h, w] of a view (distance divided by config.distance_scale).
 /// Throws std::invalid_argument on buffer sizes that do not match width × height.
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config);

@@ -57,11 +57,11 @@ struct TrainingState {
 /// A checkpoint of another network shape cannot continue: say which option differs instead of
 /// letting the weight loader fail on a missing tensor.
 void check_checkpoint_network(const std::string& path, torch::serialize::InputArchive& ar, const RefinerConfig& cfg) {
-    c10::IValue v;
-    const bool norm = !ar.try_read("config.instance_norm", v) || v.toInt() != 0;  // older files: InstanceNorm
+    const bool norm = archived_instance_norm(ar);
     if (norm != cfg.instance_norm)
         throw std::runtime_error(path + ": the checkpoint was trained with --norm " + (norm ? "instance" : "none") +
                                  "; resume with the same --norm, or start again without --resume");
+    c10::IValue v;
     if (ar.try_read("config.expansion", v) && v.toInt() != cfg.expansion)
         throw std::runtime_error(path + ": the checkpoint was trained with --expansion " + std::to_string(v.toInt()) +
                                  "; resume with the same --expansion");

@@ -50,16 +50,16 @@ def snakemake_command(a, config_path, out):
            "--configfile", config_path, "--rerun-incomplete", "--cores", str(a.cores),
            # our own lock (below) replaces Snakemake's, which a killed run leaves behind
            "--nolock"]
-    if not a.slurm:
-        # `run:` jobs (edit files, metric merges, the summary) in threads of this process: as
-        # subprocesses (Snakemake 7's local default) each one starts Python and re-reads the workflow
-        cmd += ["--force-use-threads"]
     if a.slurm:
         # Snakemake's generic cluster mode with our status script: its --slurm executor of 7.21
         # needs $USER and sacct accounting for status, which small clusters often lack.
         cmd += ["--cluster", "sbatch --parsable -J lpt-{rule} -c {threads} -o .snakemake/slurm-%j.out",
                 "--cluster-status", os.path.join(X.ROOT, "workflow", "slurm_status.py"), "--cluster-cancel", "scancel",
                 "--jobs", str(a.jobs), "--latency-wait", "30"]
+    else:
+        # `run:` jobs (edit files, metric merges, the summary) in threads of this process: as
+        # subprocesses (Snakemake 7's local default) each one starts Python and re-reads the workflow
+        cmd += ["--force-use-threads"]
     if a.redo:
         cmd += ["--forceall"]
     return cmd + a.snakemake_args
