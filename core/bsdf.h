@@ -85,6 +85,10 @@ public:
     /// Hemispherical reflectance-like colour for the albedo AOV only (not an integral; a display
     /// value): no estimator may use it.
     virtual Spectrum<N> albedo(const BSDFContext& ctx) const = 0;
+    /// Whether light arriving below the shading normal (cos wi < 0) is scattered at all. Mitsuba's
+    /// reflecting BSDFs are black from behind unless wrapped in twosided; transmissive ones see
+    /// both sides. The latent renderer needs it where no BSDF value is at hand (Ĩa, Ĩc).
+    virtual bool scatters_from_below() const { return (flags() & kTransmission) != 0; }
     /// Lambertian::No unless sample() is lambertian_sample() of a cosine-warped direction.
     virtual Lambertian lambertian() const { return Lambertian::No; }
     /// The reflectance ρ that lambertian_sample weights with, where lambertian() != No (the

@@ -22,9 +22,18 @@ public:
     }
 
     /// A path reached a vertex of `shape`. At its first non-delta vertex: Ĩa, and true when that
-    /// vertex's light sample is to decide Ĩc.
-    bool hit(PathState<N>& p, uint32_t slot, int shape, bool delta) const {
-        if (p.past_first[slot] || delta) return false;
+    /// vertex's light sample is to decide Ĩc. `black_side`: the path met the back of a surface
+    /// that scatters nothing from there (a one-sided BSDF), which RGB renders black like the
+    /// void; before a first non-delta vertex the path then scores the background, as an escape
+    /// does, rather than the surface's L̃a and L̃c, which describe its lit side.
+    bool hit(PathState<N>& p, uint32_t slot, int shape, bool delta, bool black_side) const {
+        if (p.past_first[slot]) return false;
+        if (black_side) {
+            escaped(p, slot);
+            p.past_first[slot] = 1;
+            return false;
+        }
+        if (delta) return false;
         p.past_first[slot] = 1;
         if (m_terms.ambient) {
             p.ambient[slot] += ambient_score(p.beta[slot], m_terms.La[shape]);

@@ -49,8 +49,10 @@ public:
           m_emission(!terms || terms->emission),
           m_keep_zero(terms != nullptr) {
         m_lambertian.reserve(scene.shapes.size());
-        for (size_t s = 0; s < scene.shapes.size(); ++s)
+        for (size_t s = 0; s < scene.shapes.size(); ++s) {
             m_lambertian.push_back(spectra.bsdf_of(scene, int(s)).lambertian());
+            m_scatters_below.push_back(spectra.bsdf_of(scene, int(s)).scatters_from_below());
+        }
     }
 
     /// Traces samples [s0, s0 + count) of every pixel in [x0,x1)×[y0,y1) and adds them to film.
@@ -194,7 +196,9 @@ private:
                 }
             }
             // Latent: Ĩa at the first non-delta vertex of E S* D; its light sample decides Ĩc.
-            const bool gate_here = m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id));
+            const bool gate_here =
+                m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id),
+                                          !m_scatters_below[shape_id] && si.sh.n.dot(wi_world) <= 0.f);
             // Without Ĩe nothing is collected after the first non-delta vertex.
             const bool cont = may_continue && (m_emission || !p.past_first[slot]);
             const uint8_t flags = (cont ? ShadeQueue::kContinue : 0) | (gate_here ? ShadeQueue::kFirst : 0);
@@ -391,6 +395,7 @@ private:
     /// need not be zero. Decided by what is rendered, never by whether an observer listens.
     const bool m_keep_zero;
     std::vector<Lambertian> m_lambertian;  ///< per shape: sampled from the batch-warped direction
+    std::vector<bool> m_scatters_below;    ///< per shape: its BSDF scatters light arriving from behind
 };
 
 /// Shared driver: tiles in parallel, each tile's pixels owned by one task (deterministic).

@@ -40,6 +40,7 @@ public:
     }
 
     uint32_t flags() const override { return m_nested->flags(); }
+    bool scatters_from_below() const override { return true; }
     Lambertian lambertian() const override {
         return m_nested->lambertian() == Lambertian::OneSided ? Lambertian::TwoSided : Lambertian::No;
     }

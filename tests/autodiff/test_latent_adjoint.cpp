@@ -310,3 +310,21 @@ TEST(LatentAdjoint, TextureAndEnvMapGradientsMatchFiniteDifferences) {
           "wall.bsdf.diffuse_reflectance.offset", "environment.Le"})
         EXPECT_TRUE(exercised.count(want)) << want << " has only ~0 derivatives";
 }
+
+// A camera behind the Cornell box's back wall, made one-sided: every pixel sees the wall's back,
+// which scores the background (RGB sees black there, like the void). The replayed gradient
+// follows: the background's, matching central differences, and none for the wall's own vectors.
+TEST(LatentAdjoint, TheBackOfAOneSidedWallReplaysAsTheBackground) {
+    Scene scene = small_cornell();
+    Props one_sided;
+    one_sided.type = "diffuse";
+    one_sided.file = "test";
+    scene.materials.push_back(one_sided);
+    scene.shapes[scene.find_shape("back")].material = int(scene.materials.size()) - 1;
+    scene.camera.world_from_camera =
+        Transform::look_at(Vec3f(2.78f, 2.73f, 9.f), Vec3f(2.78f, 2.73f, 0.f), Vec3f(0, 1, 0));
+    scene.camera.fov = 5.f;
+    LatentModel m(scene, Parameterisation::Code, 4);
+    const std::set<std::string> exercised = check_all_slices(m, opts(scene), 1e-3, 0.0);
+    EXPECT_EQ(exercised, std::set<std::string>{"background"});
+}

@@ -138,3 +138,36 @@ TEST(LatentTerms, OcclusionGateBothWays) {
         EXPECT_NEAR(vis_blocked[i], 0.f, 1e-6f);
     }
 }
+
+TEST(LatentTerms, TheBackOfAOneSidedSurfaceShowsTheBackground) {
+    // Seen from below, the one-sided plane is black in RGB, like the void: Ĩa = background and
+    // Ĩc = 0 exactly, not its lit side's L̃a / L̃c. Wrapped in twosided it shows L̃a again.
+    auto images = [](bool two_sided) {
+        Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 1.f);
+        if (two_sided) {
+            Props wrap;
+            wrap.type = "twosided";
+            wrap.file = "test";
+            wrap.values["bsdf"] = std::make_shared<Props>(scene.materials[scene.shapes[0].material]);
+            scene.materials.push_back(wrap);
+            scene.shapes[scene.find_shape("plane")].material = int(scene.materials.size()) - 1;
+        }
+        scene.camera.world_from_camera = Transform::look_at(Vec3f(0, 0, -0.5f), Vec3f(0, 0, 0), Vec3f(0, 1, 0));
+        auto spectra = SceneSpectra<16>::from_description(scene);
+        LatentTerms<16> t = zero_terms(scene);
+        t.La[scene.find_shape("plane")] = ramp(-0.3f, 0.8f);
+        t.Lc[scene.find_shape("plane")] = ramp(0.9f, -0.4f);
+        t.background = ramp(0.2f, -0.6f);
+        auto films = render_latent_terms<16>(scene, spectra, t, options(scene));
+        return std::tuple{films.a.develop(), films.c.develop(), t};
+    };
+    auto [a1, c1, t1] = images(false);
+    for (size_t i = 0; i < a1.size(); ++i) {
+        EXPECT_NEAR(a1[i], t1.background[int(i % 16)], 1e-6f);
+        EXPECT_EQ(c1[i], 0.f);
+    }
+    auto [a2, c2, t2] = images(true);
+    const S16 la = t2.La[0];
+    for (size_t i = 0; i < a2.size(); ++i) EXPECT_NEAR(a2[i], la[int(i % 16)], 1e-6f);
+    EXPECT_GT(max_abs(c2), 0.1f) << "the plane shadows itself from below: Ĩc must count there";
+}
