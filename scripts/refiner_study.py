@@ -28,20 +28,38 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import experiment_lib as X  # noqa: E402
 
 # name -> (what it tests, `latentpt refine` options, drop the path-traced RGB so that LPIPS
-# compares with the decoded target as in the paper's loss); None options: keep the fit's refiner
+# compares with the decoded target as in the paper's loss, iterations: None = --iterations);
+# None options: keep the fit's refiner
 VARIANTS = {
-    "default": ("the fit's refiner: MSE + D-SSIM + LPIPS, 32² crops, InstanceNorm, lr 5e-4", None, False),
-    "no_norm": ("no InstanceNorm (crops and whole views see one function)", ["--norm", "none"], False),
+    "default": ("the fit's refiner: MSE + D-SSIM + LPIPS, 32² crops, InstanceNorm, lr 5e-4", None, False, None),
+    "no_norm": ("no InstanceNorm (crops and whole views see one function)", ["--norm", "none"], False, None),
     "paper": ("the paper's text where it differs: no InstanceNorm, LPIPS to dec(target), lr 1e-4 (crops, dropout, "
-              "iterations ours)", ["--norm", "none", "--lr", "1e-4"], True),
-    "mse_only": ("the paper code's latent MSE alone", ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False),
-    "lpips_to_target": ("LPIPS against dec(target), the paper's loss, not the path-traced RGB", [], True),
-    "whole_view": ("whole-view training (InstanceNorm statistics as at inference)", ["--crop", "0", "--lpips-crop", "32"], False),
-    "lr_1e-4": ("the paper's learning rate 1e-4", ["--lr", "1e-4"], False),
-    "mse_x10": ("latent MSE weighted 10", ["--w-mse", "10"], False),
-    "expansion_8": ("half the width (expansion 8)", ["--expansion", "8"], False),
-    "no_dropout": ("dropout 0", ["--dropout", "0"], False),
+              "iterations ours)", ["--norm", "none", "--lr", "1e-4"], True, None),
+    "mse_only": ("the paper code's latent MSE alone", ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False,
+                 None),
+    "lpips_to_target": ("LPIPS against dec(target), the paper's loss, not the path-traced RGB", [], True, None),
+    "whole_view": ("whole-view training (InstanceNorm statistics as at inference)", ["--crop", "0", "--lpips-crop", "32"],
+                   False, None),
+    "lr_1e-4": ("the paper's learning rate 1e-4", ["--lr", "1e-4"], False, None),
+    "mse_x10": ("latent MSE weighted 10", ["--w-mse", "10"], False, None),
+    "expansion_8": ("half the width (expansion 8)", ["--expansion", "8"], False, None),
+    "no_dropout": ("dropout 0", ["--dropout", "0"], False, None),
+    "mse_ssim": ("latent MSE + D-SSIM, no LPIPS (no decoder in the loop: a quarter of the step's time)",
+                 ["--w-lpips", "0", "--lpips-crop", "0"], False, None),
+    "mse_only_long": ("latent MSE alone for 3000 iterations (about the default's training time)",
+                      ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False, 3000),
+    "mse_only_crop64": ("latent MSE alone on 64² crops (4× the pixels per step; InstanceNorm nearer the whole view)",
+                        ["--crop", "64", "--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False, None),
+    "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),
+    "lpips8_long": ("ours with 8² latent LPIPS crops (a quarter of the decode) for 3000 iterations", ["--lpips-crop", "8"],
+                    False, 3000),
 }
+
+
+def iterations_of(a, name):
+    return VARIANTS[name][3] or a.iterations
+
+
 
 
 def run(cmd, log):
@@ -57,9 +75,10 @@ def train_variant(a, name, vdir):
     """A copy of the stage-1 fit with its refiner retrained by the variant's options (kept as is
     for 'default'). refine.done records what made the folder: a folder made otherwise (another
     fit, options or iterations) is an error, not silently reused."""
-    _, opts, drop_rgb = VARIANTS[name]
+    _, opts, drop_rgb, _ = VARIANTS[name]
+    iterations = iterations_of(a, name)
     stamp = json.dumps({"fit": os.path.abspath(a.fit), "options": opts, "drop_rgb": drop_rgb,
-                        "iterations": None if opts is None else a.iterations})
+                        "iterations": None if opts is None else iterations})
     done = os.path.join(vdir, "refine.done")
     if os.path.exists(done):
         with open(done) as f:
@@ -78,7 +97,7 @@ def train_variant(a, name, vdir):
         os.replace(tmp, vdir)
     if opts is not None:
         resume = ["--resume"] if os.path.exists(os.path.join(vdir, "refiner_checkpoint.pt")) else []
-        run([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(a.iterations), "--seed", "0",
+        run([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(iterations), "--seed", "0",
              "-q"] + opts + resume, os.path.join(vdir, "study.log"))
     X.write_atomic(done, stamp)
 
@@ -106,7 +125,8 @@ def training_view(vdir):
 
 def report(a, results):
     md = [f"# Refiner study on {a.scene_dir}", "",
-          f"Stage-1 fit {a.fit}; refiner {a.iterations} iterations (the default variant: the fit's own); "
+          f"Stage-1 fit {a.fit}; refiner {a.iterations} iterations unless the variant names its own "
+          "(the default variant: the fit's own refiner); "
           f"frames {a.frames} of each edit sequence at {a.spp} spp "
           f"against {a.ref_spp}-spp references. Mean refined LPIPS / MSE×100 (edit columns include frame 0, the "
           "training view, as the paper's means do; 'edited' excludes it). Choose by the edit means.", "",
