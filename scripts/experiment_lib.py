@@ -351,14 +351,20 @@ def training_reference_command(c, scene, threads):
     return shlex.join(fit_argv(c, scene, "e", threads, os.path.join(scene, "refs", "training_fit"), iterations=1, final_spp=1))
 
 
+def edit_argv(binary, threads, fitdir, edits, out, spp, ref_spp, refs, frames=None):
+    """`latentpt render <fitdir> --edit --reference` of the frames "A:B:S" (all when None) against
+    references cached in `refs`, resuming a killed run. Snakemake compares its jobs' commands
+    with the recorded ones: keep the order of the arguments."""
+    cmd = [binary, "--threads", str(threads), "render", fitdir, "--edit", edits, "--reference", "--ref-spp",
+           str(ref_spp), "--reference-cache", refs, "--spp", str(spp), "-q", "--resume", "--out", out]
+    return cmd + (["--frames", frames] if frames else [])
+
+
 def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
-    """`latentpt render --edit --reference` of frames A:B (all when None), resuming a killed job."""
-    cmd = [c["bin"], "--threads", str(threads), "render", os.path.join(scene, "fit_" + fit), "--edit", edits,
-           "--reference", "--ref-spp", str(ref_spp_of(c, scene)), "--reference-cache", os.path.join(scene, "refs"),
-           "--spp", str(spp), "-q", "--resume", "--out", out]
-    if frames:
-        cmd += ["--frames", f"{frames[0]}:{frames[1]}:{c.get('frame_step', 1)}"]
-    return shlex.join(cmd)
+    """edit_argv of one ablation fit and frames A:B (all when None), as a shell command."""
+    spec = f"{frames[0]}:{frames[1]}:{c.get('frame_step', 1)}" if frames else None
+    return shlex.join(edit_argv(c["bin"], threads, os.path.join(scene, "fit_" + fit), edits, out, spp,
+                                ref_spp_of(c, scene), os.path.join(scene, "refs"), spec))
 
 
 def edit_sequence(c, scene, kind):

@@ -106,9 +106,8 @@ def evaluate(a, vdir, kind):
     """Mean refined metrics of one edit sequence (the evaluated frames) rendered by the variant."""
     out = os.path.join(vdir, "edit_" + kind)
     first, last, step = (int(x) for x in a.frames.split(":"))
-    run([a.bin, "--threads", str(a.threads), "render", vdir, "--edit", os.path.join(a.scene_dir, f"edits-{kind}.json"),
-         "--reference", "--ref-spp", str(a.ref_spp), "--reference-cache", os.path.join(a.scene_dir, "refs"),
-         "--spp", str(a.spp), "--frames", a.frames, "--resume", "-q", "--out", out], os.path.join(vdir, "study.log"))
+    run(X.edit_argv(a.bin, a.threads, vdir, os.path.join(a.scene_dir, f"edits-{kind}.json"), out, a.spp, a.ref_spp,
+                    os.path.join(a.scene_dir, "refs"), a.frames), os.path.join(vdir, "study.log"))
     rows = X.read_metrics(os.path.join(out, f"metrics_{first}-{last}.csv"))
     edited = [r for r in rows if int(r["frame"]) != 0]
     return {"lpips": X.mean(rows, "refined_rgb_lpips"), "mse_x100": X.mean(rows, "refined_rgb_mse_x100"),
