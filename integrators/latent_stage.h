@@ -14,7 +14,8 @@ class LatentStage {
 public:
     LatentStage(const LatentTerms<N>& terms, PathObserver<N>* observer) : m_terms(terms), m_obs(observer) {}
 
-    /// A path escaped: the background joins Ĩa unless a non-delta vertex came before.
+    /// A path escaped (or met a surface's black side, see hit()): the background joins Ĩa
+    /// unless a non-delta vertex came before.
     void escaped(PathState<N>& p, uint32_t slot) const {
         if (!m_terms.ambient || p.past_first[slot]) return;
         p.ambient[slot] += ambient_score(p.beta[slot], m_terms.background);

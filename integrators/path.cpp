@@ -196,6 +196,7 @@ private:
                 }
             }
             // Latent: Ĩa at the first non-delta vertex of E S* D; its light sample decides Ĩc.
+            // Before it, the back of a one-sided surface scores the background (docs/transport.md (6)).
             const bool gate_here =
                 m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id),
                                           !m_scatters_below[shape_id] && si.sh.n.dot(wi_world) <= 0.f);
@@ -216,7 +217,7 @@ private:
     }
 
     /// Stage 2: next-event estimation (docs/transport.md (2)) for every non-delta vertex; at the
-    /// latent first vertex the same light sample gates Ĩc (docs/transport.md (6)).
+    /// latent first vertex the same light sample gates Ĩc (docs/transport.md (7)).
     void sample_lights(Workspace<N>& ws, int depth) const {
         PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;

@@ -24,14 +24,14 @@ Spectrum<N> nee_score(const Spectrum<N>& beta, const Spectrum<N>& f, const Spect
     return beta * f * le * w_over_pdf;
 }
 
-/// Ĩa: β · L̃a at the first non-delta vertex, or β · background for a path that escapes
-/// before reaching one (along delta bounces). (5)
+/// Ĩa: β · L̃a at the first non-delta vertex, or β · background for a path that escapes, or
+/// meets the back of a one-sided surface, before reaching one (along delta bounces). (6)
 template <int N>
 Spectrum<N> ambient_score(const Spectrum<N>& beta, const Spectrum<N>& la) {
     return beta * la;
 }
 
-/// Ĩc: β · L̃c at the first non-delta vertex, where that vertex's light sample passes the gate. (6)
+/// Ĩc: β · L̃c at the first non-delta vertex, where that vertex's light sample passes the gate. (7)
 template <int N>
 Spectrum<N> occlusion_score(const Spectrum<N>& beta, const Spectrum<N>& lc) {
     return beta * lc;
