@@ -38,7 +38,10 @@ struct RefinerInput {
 struct RefinerTrainOptions {
     int iterations = 3000;
     float lr = 5e-4f;
-    float w_mse = 1.f, w_ssim = 1.f, w_lpips = 1.f;  ///< loss = w·MSE + w·(1 − SSIM) + w·LPIPS
+    /// loss = w·MSE + w·(1 − SSIM) + w·LPIPS. MSE alone by default: on cbox-specular's edits it
+    /// beat our earlier mix (1, 1, 1) in both metrics at the same training time, because without
+    /// a decoder in the loop a step costs a quarter (docs/refiner.md, docs/results.md).
+    float w_mse = 1.f, w_ssim = 0.f, w_lpips = 0.f;
     int crop = 32;        ///< latent pixels per side of the training crop; 0 = the whole view
     int lpips_crop = 16;  ///< latent pixels per side decoded for LPIPS (8× in RGB); 0 = no LPIPS
     int patience = 500;   ///< early stopping on the smoothed loss; 0 = off

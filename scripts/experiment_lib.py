@@ -252,7 +252,7 @@ def write_outputs(out, c, summary, failures, timings):
 PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
          "scene_res": {"cbox-specular": 1024, "veach-bidir": 512, "dining-room": 512},
          "frame_step": 15, "ref_spp": 512, "training_ref_spp": 512, "fit_iterations": 3000,
-         "refiner_iterations": 1000, "fits": ["e", "ea", "eac"], "spp_list": [1, 4, 16, 64, 256],
+         "refiner_iterations": 3000, "fits": ["e", "ea", "eac"], "spp_list": [1, 4, 16, 64, 256],
          "conv_views": ["training"], "equal_error_max_spp": 64}
 
 
@@ -268,7 +268,7 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "root": ROOT, "image_res": image_res or (128 if quick else 256),
             "scene_res": {} if image_res else p.get("scene_res", {}),
             "fit_iterations": fit_iterations or p.get("fit_iterations") or (300 if quick else 1500),
-            "refiner_iterations": refiner_iterations or p.get("refiner_iterations") or (100 if quick else 1000),
+            "refiner_iterations": refiner_iterations or p.get("refiner_iterations") or (300 if quick else 3000),
             "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
             "ref_spp": ref_spp or p.get("ref_spp") or (32 if quick else None),
             "training_ref_spp": p.get("training_ref_spp"), "fits": p.get("fits", list(FITS)), "spp": spp,

@@ -70,6 +70,7 @@ RefinerTrainOptions latent_training(int iterations, int crop) {
     o.iterations = iterations;
     o.lr = 3e-3f;
     o.crop = crop;
+    o.w_ssim = 1.f;  // latent MSE + D-SSIM: both latent terms exercised, no decoder
     o.w_lpips = 0.f;
     o.patience = 0;
     return o;
@@ -263,6 +264,7 @@ TEST(Refiner, LpipsThroughTheDecoderTrains) {
     o.lpips_crop = 4;  // 32x32 RGB
     o.w_mse = 0.f;
     o.w_ssim = 0.f;
+    o.w_lpips = 1.f;
     o.patience = 0;
     RefinerTrainResult res = r->train(p.in, p.target, &rgb, vae.get(), lpips.get(), o);
     ASSERT_EQ(res.history.size(), 8u);
