@@ -48,6 +48,7 @@ VARIANTS = {
                  ["--w-lpips", "0", "--lpips-crop", "0"], False, None),
     "mse_only_long": ("latent MSE alone for 3000 iterations (about the default's training time)",
                       ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False, 3000),
+    "mse_ssim_long": ("latent MSE + D-SSIM for 3000 iterations", ["--w-lpips", "0", "--lpips-crop", "0"], False, 3000),
     "mse_only_crop64": ("latent MSE alone on 64² crops (4× the pixels per step; InstanceNorm nearer the whole view)",
                         ["--crop", "64", "--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False, None),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),
