@@ -3,7 +3,7 @@
 // eval_transmittance / eval_reflectance), tabulated over 64 cosines μ_j = j/63, with their exact
 // α-derivatives.
 //
-// Why a cache over α: a fit moves α every Adam step, and the direct quadrature costs 6–10 ms
+// Why a cache over α: a fit moves α every Adam step, and the direct quadrature costs 40–90 ms
 // per (t, ∂t/∂α) pair; 33 rough-plastic shapes (dining-room) spent > 90% of each step there.
 // The tables are therefore computed once per node α_k = 1e-4·exp(k/8) and per (distribution, η),
 // shared by every BSDF and thread, and interpolated in s = ln α by cubic Hermite splines whose
@@ -19,8 +19,10 @@ namespace lpt {
 
 constexpr int kTransmittanceRes = 64;
 
-/// Which lobe of the interface a table integrates: the refracted energy T(μ) or the reflected A(μ).
-enum class CoatingLobe { Transmission, Reflection };
+/// Which lobe of the interface a table integrates: the refracted energy T(μ), the reflected A(μ),
+/// or the reflected lobe without Fresnel, D G / (4 μ) alone (its albedo: what a Fresnel-free
+/// microfacet BSDF such as Cycles' Glossy reflects; cycles_approximation.h).
+enum class CoatingLobe { Transmission, Reflection, Glossy };
 
 /// One lobe's albedo over μ_j (named after its main use, the transmittance t).
 struct TransmittanceTable {
@@ -40,7 +42,7 @@ inline TransmittanceTable rough_reflectance(MicrofacetType type, float eta, floa
     return rough_lobe_table(type, eta, alpha, CoatingLobe::Reflection);
 }
 
-/// A lobe's table by direct quadrature at alpha (uncached, 6–10 ms): the nodes of the above,
+/// A lobe's table by direct quadrature at alpha (uncached, 40–90 ms): the nodes of the above,
 /// and the reference its interpolation is tested against. dt here is the quadrature of the
 /// exact derivative integral (42), not the slope of t's quadrature.
 TransmittanceTable rough_lobe_table_direct(MicrofacetType type, float eta, float alpha, CoatingLobe lobe);
