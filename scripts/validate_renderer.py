@@ -12,6 +12,13 @@ ratios, 32x32 block ratios against their noise, emitter-masked relMSE and pictur
     <out>/<scene>/compare/    comparison.txt/.json, side_by_side.png, ratio_map.png
     <out>/summary.md, summary.json
 
+With --split, ours also renders the scene as the Cycles translation approximates it (the
+validation-only key cycles_approximation on every plastic, roughplastic and roughconductor,
+docs/bsdfs.md (47)-(49)), which splits the difference in two:
+
+    <out>/<scene>/translation/     ours / ours approximated: what the translation changes
+    <out>/<scene>/compare_approx/  ours approximated / Cycles: what is left
+
 Finished renders are reused when rerun with the same settings and the same latentpt binary /
 translation script (resumable; a rebuilt latentpt renders again); --force redoes them.
 Without Blender the Cycles side is skipped and the summary says so.
@@ -20,6 +27,7 @@ import argparse
 import hashlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -111,6 +119,55 @@ def render_once(kind, args, scene_path, out_exr, seed, extra, log):
     return seconds, False
 
 
+APPROXIMATED_BSDFS = ("plastic", "roughplastic", "roughconductor")
+
+
+def approximated_scene(scene_path, folder):
+    """A copy of the scene XML with cycles_approximation on every plastic, roughplastic and
+    roughconductor, in <folder>/approximated/ beside links to everything else of the scene's folder
+    (meshes and textures are named relative to the XML). Returns its path and how many BSDFs it
+    changed."""
+    with open(scene_path) as f:
+        text = f.read()
+    flag = '<boolean name="cycles_approximation" value="true"/>'
+    pattern = re.compile(r'<bsdf\b([^>]*\btype\s*=\s*"(?:%s)"[^>]*?)(/?)>' % "|".join(APPROXIMATED_BSDFS))
+
+    def add_flag(m):
+        return "<bsdf%s>%s%s" % (m.group(1), flag, "</bsdf>" if m.group(2) else "")
+
+    text, changed = pattern.subn(add_flag, text)
+    out_dir = os.path.join(folder, "approximated")
+    os.makedirs(out_dir, exist_ok=True)
+    src_dir = os.path.dirname(os.path.abspath(scene_path))
+    for entry in os.listdir(src_dir):
+        link = os.path.join(out_dir, entry)
+        if entry != os.path.basename(scene_path) and not os.path.lexists(link):
+            os.symlink(os.path.join(src_dir, entry), link)
+    out = os.path.join(out_dir, os.path.basename(scene_path))
+    tmp = out + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, out)
+    return out, changed
+
+
+def compare(args, log, test, ref, scene_path, out_dir, extra):
+    """`latentpt compare` of two render pairs; prints its text and returns the summary fields."""
+    cmd = [args.bin, "compare", "--test"] + test + ["--ref"] + ref + ["--scene", scene_path, "-o", out_dir] + extra
+    run(cmd, log)
+    with open(os.path.join(out_dir, "comparison.json")) as f:
+        c = json.load(f)
+    with open(os.path.join(out_dir, "comparison.txt")) as f:
+        print(f.read(), flush=True)
+    blocks = [b for b in c["blocks"] if b["pixels"] > 0]
+    return {
+        "mean_ratio": c["mean_ratio"], "mean_ratio_sigma": c["mean_ratio_sigma"], "rel_mse": c["rel_mse"],
+        "blocks": len(blocks), "blocks_flagged": c["blocks_flagged"],
+        "blocks_brighter": sum(1 for b in blocks if b["ratio"] > 1.0),
+        "max_abs_z": max(abs(b["z"]) for b in blocks) if blocks else 0.0,
+    }
+
+
 def approximations(cycles_exr):
     try:
         with open(cycles_exr + ".json") as f:
@@ -130,6 +187,9 @@ def main():
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--force", action="store_true", help="re-render even where finished renders exist")
     ap.add_argument("-D", dest="defines", action="append", default=[], help="scene override for both renderers, e.g. max_depth=6")
+    ap.add_argument("--split", action="store_true",
+                    help="also render ours as the Cycles translation approximates plastic, roughplastic and roughconductor "
+                         "(seeds 3 and 4) and compare it with ours and with Cycles (docs/validation.md)")
     args = ap.parse_args()
 
     have_blender = shutil.which(args.blender) is not None
@@ -151,35 +211,30 @@ def main():
         log = os.path.join(folder, "log.txt")
         entry = {"scene": name, "file": SCENES[name], "res": args.res, "spp": args.spp, "defines": args.defines}
 
-        def render_pair(kind):
-            """Both seeds of one renderer; returns their seconds."""
-            total = 0.0
-            for seed in (1, 2):
-                s, reused = render_once(kind, args, scene_path, os.path.join(folder, "%s_%d.exr" % (kind, seed)), seed, extra, log)
+        def render_pair(kind, label=None, path=scene_path, seeds=(1, 2)):
+            """Both seeds of one renderer; returns their files and seconds."""
+            total, files = 0.0, []
+            for seed in seeds:
+                files.append(os.path.join(folder, "%s_%d.exr" % (label or kind, seed)))
+                s, reused = render_once(kind, args, path, files[-1], seed, extra, log)
                 total += s
-                print("validate: %s %s seed %d: %s" % (name, kind, seed, "reused" if reused else "%.1f s" % s), flush=True)
-            return total
+                print("validate: %s %s seed %d: %s" % (name, label or kind, seed, "reused" if reused else "%.1f s" % s),
+                      flush=True)
+            return files, total
 
-        entry["seconds_ours"] = render_pair("ours")
+        ours, entry["seconds_ours"] = render_pair("ours")
+        if args.split:
+            approx_path, changed = approximated_scene(scene_path, folder)
+            entry["approximated_bsdfs"] = changed
+            approx, entry["seconds_ours_approximated"] = render_pair("ours", "ours_approximated", approx_path, (3, 4))
+            entry["translation"] = compare(args, log, ours, approx, scene_path, os.path.join(folder, "translation"), extra)
         if have_blender:
-            entry["seconds_cycles"] = render_pair("cycles")
-            entry["approximations"] = approximations(os.path.join(folder, "cycles_1.exr"))
-            cmp_dir = os.path.join(folder, "compare")
-            cmd = [args.bin, "compare", "--test", os.path.join(folder, "ours_1.exr"), os.path.join(folder, "ours_2.exr"),
-                   "--ref", os.path.join(folder, "cycles_1.exr"), os.path.join(folder, "cycles_2.exr"),
-                   "--scene", scene_path, "-o", cmp_dir] + extra
-            run(cmd, log)
-            with open(os.path.join(cmp_dir, "comparison.json")) as f:
-                c = json.load(f)
-            with open(os.path.join(cmp_dir, "comparison.txt")) as f:
-                print(f.read(), flush=True)
-            blocks = [b for b in c["blocks"] if b["pixels"] > 0]
-            entry.update({
-                "mean_ratio": c["mean_ratio"], "mean_ratio_sigma": c["mean_ratio_sigma"], "rel_mse": c["rel_mse"],
-                "blocks": len(blocks), "blocks_flagged": c["blocks_flagged"],
-                "blocks_brighter": sum(1 for b in blocks if b["ratio"] > 1.0),
-                "max_abs_z": max(abs(b["z"]) for b in blocks) if blocks else 0.0,
-            })
+            cycles, entry["seconds_cycles"] = render_pair("cycles")
+            entry["approximations"] = approximations(cycles[0])
+            entry.update(compare(args, log, ours, cycles, scene_path, os.path.join(folder, "compare"), extra))
+            if args.split:
+                entry["approximated"] = compare(args, log, approx, cycles, scene_path,
+                                                os.path.join(folder, "compare_approx"), extra)
         summary.append(entry)
         write_summary(args.out, summary, have_blender)
     print("validate: wrote %s" % os.path.join(args.out, "summary.md"))
@@ -188,14 +243,22 @@ def main():
 def write_summary(out, summary, have_blender):
     lines = ["| scene | ours / Cycles mean R | G | B | relMSE (emitters masked) | 32² blocks beyond 3σ | max abs(z) | "
              "blocks brighter | time ours / Cycles |", "|---|---|---|---|---|---|---|---|---|"]
+    def row(label, c, times):
+        r, s = c["mean_ratio"], c["mean_ratio_sigma"]
+        return "| %s | %.4f ± %.4f | %.4f ± %.4f | %.4f ± %.4f | %.5f | %d of %d | %.1f | %d | %s |" % (
+            label, r[0], s[0], r[1], s[1], r[2], s[2], c["rel_mse"], c["blocks_flagged"], c["blocks"], c["max_abs_z"],
+            c["blocks_brighter"], times)
+
     for e in summary:
-        if "mean_ratio" not in e:
+        if "mean_ratio" in e:
+            lines.append(row(e["scene"], e, "%.0f s / %.0f s" % (e["seconds_ours"], e["seconds_cycles"])))
+        else:
             lines.append("| %s | – | – | – | – | – | – | – | %.0f s / (no Blender) |" % (e["scene"], e["seconds_ours"]))
-            continue
-        r, s = e["mean_ratio"], e["mean_ratio_sigma"]
-        lines.append("| %s | %.4f ± %.4f | %.4f ± %.4f | %.4f ± %.4f | %.5f | %d of %d | %.1f | %d | %.0f s / %.0f s |" % (
-            e["scene"], r[0], s[0], r[1], s[1], r[2], s[2], e["rel_mse"], e["blocks_flagged"], e["blocks"], e["max_abs_z"],
-            e["blocks_brighter"], e["seconds_ours"], e["seconds_cycles"]))
+        if "translation" in e:
+            lines.append(row("%s: ours / ours approximated (%d BSDFs)" % (e["scene"], e["approximated_bsdfs"]),
+                             e["translation"], "%.0f s approximated" % e["seconds_ours_approximated"]))
+        if "approximated" in e:
+            lines.append(row("%s: ours approximated / Cycles" % e["scene"], e["approximated"], ""))
     text = "\n".join(lines) + "\n"
     if not have_blender:
         text += "\nNo Blender on this machine: only our renders were made.\n"

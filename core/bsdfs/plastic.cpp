@@ -13,8 +13,11 @@
 // Gradients w.r.t. the diffuse colour (keys below the substrate's key_count: diffuse_reflectance, or its
 // .scale/.offset when latent-textured, ∂ρ̃/∂c = ∂ρ̃/∂ρ · ∂ρ/∂c) and specular_reflectance (the last key): docs/bsdfs.md
 // (34)-(35); with nonlinear = true the base colour is not affine in diffuse_reflectance.
-// Equations: docs/bsdfs.md (1), (4), (22)-(24), (34)-(35).
+// cycles_approximation (bool, validation only): 1 − R(cos θo) by its cosine-weighted mean,
+// core/bsdfs/cycles_approximation.h.
+// Equations: docs/bsdfs.md (1), (4), (22)-(24), (34)-(35), (48).
 #include "core/bsdf.h"
+#include "core/bsdfs/cycles_approximation.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/plastic_substrate.h"
 #include "core/warp.h"
@@ -29,9 +32,11 @@ public:
     explicit SmoothPlastic(const Props& props)
         : m_eta(read_relative_ior(props, 1.49f, 1.000277f, false)),
           m_substrate(props),
-          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))) {
+          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
+          m_cycles_approximation(read_cycles_approximation<N>(props)) {
         m_inv_eta2 = 1.f / (m_eta * m_eta);
         m_substrate.set_internal_reflectance(fresnel_diffuse_reflectance(1.f / m_eta));
+        if (m_cycles_approximation) m_mean_t_out = 1.f - fresnel_diffuse_reflectance(m_eta);
     }
 
     /// The substrate colour's keys (diffuse_reflectance, or .scale/.offset when latent-textured),
@@ -49,7 +54,7 @@ public:
     Spectrum<N> eval(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const override {
         if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
         float t_i = 1.f - fresnel_dielectric(cos_theta(wi), m_eta).R;
-        float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
+        float t_o = transmitted_out(cos_theta(wo));
         return m_substrate.base(ctx) * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));  // docs/bsdfs.md (23)
     }
 
@@ -73,7 +78,7 @@ public:
         Vec3f wo = sample_cosine_hemisphere(u2);
         float pdf = (1.f - r_i) * pdf_cosine_hemisphere(wo);
         if (!(pdf > 0.f)) return bs;
-        float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
+        float t_o = transmitted_out(cos_theta(wo));
         bs.wo = wo;
         bs.pdf = pdf;
         bs.lobe = kDiffuseReflection;
@@ -92,7 +97,7 @@ public:
     Spectrum<N> eval_grad(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
         if (key >= m_substrate.key_count() || cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
         float t_i = 1.f - fresnel_dielectric(cos_theta(wi), m_eta).R;
-        float t_o = 1.f - fresnel_dielectric(cos_theta(wo), m_eta).R;
+        float t_o = transmitted_out(cos_theta(wo));
         return m_substrate.d_base(ctx, key) * (m_inv_eta2 * t_i * t_o * kInvPi * cos_theta(wo));
     }
     /// ∂(bs.weight)/∂c, docs/bsdfs.md (35): the delta sample's weight is specular_reflectance
@@ -102,14 +107,22 @@ public:
         const bool specular_key = key == m_substrate.key_count();
         if (bs.lobe == kDeltaReflection) return Spectrum<N>::Constant(specular_key ? 1.f : 0.f);
         if (specular_key) return Spectrum<N>::Zero();
-        float t_o = 1.f - fresnel_dielectric(cos_theta(bs.wo), m_eta).R;
+        float t_o = transmitted_out(cos_theta(bs.wo));
         return m_substrate.d_base(ctx, key) * (m_inv_eta2 * t_o);
     }
 
 private:
+    /// 1 − R(cos θo), the diffuse lobe's way out; its cosine-weighted mean 1 − Fdr(η) under
+    /// cycles_approximation (docs/bsdfs.md (48)).
+    float transmitted_out(float cos_o) const {
+        return m_cycles_approximation ? m_mean_t_out : 1.f - fresnel_dielectric(cos_o, m_eta).R;
+    }
+
     float m_eta, m_inv_eta2 = 1.f;
     PlasticSubstrate<N> m_substrate;  ///< ρ̃ after internal bounces, docs/bsdfs.md (23)
     Spectrum<N> m_specular;
+    bool m_cycles_approximation;
+    float m_mean_t_out = 0.f;
 };
 
 }  // namespace

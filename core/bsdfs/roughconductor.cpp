@@ -7,8 +7,10 @@
 // Mitsuba 0.6 name copper as the default; copper needs an IOR database, which we do not ship.
 // Gradients: ∂/∂specular_reflectance of eval and of the sample weight, docs/bsdfs.md (30)-(31);
 // scalar key "alpha" (roughness), ∂/∂α of eval and of the weight, docs/bsdfs.md (37)-(40), (43).
-// Equations: docs/bsdfs.md (10), (12), (15)-(16), (30)-(31), (37)-(40), (43).
+// cycles_approximation (bool, validation only): F at the macro normal, core/bsdfs/cycles_approximation.h.
+// Equations: docs/bsdfs.md (10), (12), (15)-(16), (30)-(31), (37)-(40), (43), (47).
 #include "core/bsdf.h"
+#include "core/bsdfs/cycles_approximation.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/microfacet.h"
 
@@ -21,14 +23,15 @@ public:
     explicit RoughConductor(const Props& props)
         : m_distr(read_distribution(props), read_alpha(props)),
           m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
-          m_ior(read_conductor_ior<N>(props)) {}
+          m_ior(read_conductor_ior<N>(props)),
+          m_cycles_approximation(read_cycles_approximation<N>(props)) {}
 
     Spectrum<N> eval(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
         if (cos_theta(wi) <= 0.f || cos_theta(wo) <= 0.f) return Spectrum<N>::Zero();
         Vec3f h = (wi + wo).normalized();
         float value = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_theta(wi));  // docs/bsdfs.md (15)
         if (value == 0.f) return Spectrum<N>::Zero();
-        return m_specular * m_ior.fresnel(wi.dot(h)) * value;
+        return m_specular * fresnel(wi, h) * value;
     }
 
     float pdf(const BSDFContext&, const Vec3f& wi, const Vec3f& wo) const override {
@@ -49,7 +52,7 @@ public:
         bs.wo = wo;
         bs.pdf = pdf;
         bs.lobe = kGlossyReflection;
-        bs.weight = m_specular * m_ior.fresnel(wi.dot(m)) * m_distr.sample_weight(wi, wo, m);  // (12)
+        bs.weight = m_specular * fresnel(wi, m) * m_distr.sample_weight(wi, wo, m);  // (12)
         return bs;
     }
 
@@ -63,14 +66,14 @@ public:
         Vec3f h = (wi + wo).normalized();
         float value = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_theta(wi));
         if (value == 0.f) return Spectrum<N>::Zero();
-        return m_ior.fresnel(wi.dot(h)) * value;
+        return fresnel(wi, h) * value;
     }
     /// ∂(bs.weight)/∂specular_reflectance = F(wi·m) w(12), docs/bsdfs.md (31): the derivative of
     /// the closed form sample() uses (equal to eval_grad/pdf only up to rounding), with the
     /// microfacet normal m recovered as the reflection half vector of (wi, bs.wo).
     Spectrum<N> weight_grad(const BSDFContext&, const Vec3f& wi, const BSDFSample<N>& bs, int) const override {
         Vec3f m = (wi + bs.wo).normalized();
-        return m_ior.fresnel(wi.dot(m)) * m_distr.sample_weight(wi, bs.wo, m);
+        return fresnel(wi, m) * m_distr.sample_weight(wi, bs.wo, m);
     }
 
     std::vector<std::string> spectral_keys() const override { return {"specular_reflectance"}; }
@@ -102,13 +105,20 @@ public:
         Vec3f h = (wi + wo).normalized();
         float dvalue = m_distr.dDG_dalpha(wi, wo, h) / (4.f * cos_theta(wi));
         if (dvalue == 0.f) return Spectrum<N>::Zero();
-        return m_specular * m_ior.fresnel(wi.dot(h)) * dvalue;
+        return m_specular * fresnel(wi, h) * dvalue;
     }
 
 private:
+    /// F at the microfacet normal m; at the macro normal under cycles_approximation
+    /// (docs/bsdfs.md (47)).
+    Spectrum<N> fresnel(const Vec3f& wi, const Vec3f& m) const {
+        return m_ior.fresnel(m_cycles_approximation ? cos_theta(wi) : wi.dot(m));
+    }
+
     MicrofacetDistribution m_distr;
     Spectrum<N> m_specular;
     ConductorIOR<N> m_ior;
+    bool m_cycles_approximation;
 };
 
 }  // namespace

@@ -21,8 +21,11 @@
 // t(cos θo) and Fdr_int. The tables come from rough_transmittance.h: cached nodes in ln α,
 // interpolated, so a set_scalar costs microseconds and ∂t/∂α is the exact derivative of the t
 // that eval uses: docs/bsdfs.md (42)-(43), (46).
-// Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28), (34), (36)-(39), (42)-(43), (46).
+// cycles_approximation (bool, validation only; core/bsdfs/cycles_approximation.h): t(cos θo) by
+// T̄, and the specular Fresnel by R(cos θi)/A_glossy(cos θi) at the macro normal.
+// Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28), (34), (36)-(39), (42)-(43), (46), (49).
 #include "core/bsdf.h"
+#include "core/bsdfs/cycles_approximation.h"
 #include "core/bsdfs/fresnel.h"
 #include "core/bsdfs/plastic_substrate.h"
 #include "core/bsdfs/microfacet.h"
@@ -40,7 +43,8 @@ public:
         : m_distr(read_distribution(props), read_alpha(props)),
           m_eta(read_relative_ior(props, 1.49f, 1.000277f, true)),
           m_substrate(props),
-          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))) {
+          m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
+          m_cycles_approximation(read_cycles_approximation<N>(props)) {
         m_inv_eta2 = 1.f / (m_eta * m_eta);
         rebuild();
     }
@@ -65,7 +69,7 @@ public:
     /// Raised to MicrofacetDistribution::kMinAlpha (1e-4) as at construction, then everything
     /// derived from alpha is rebuilt: t(mu) and ∂t/∂α tables, Fdr_int, ρ̃ and their
     /// α-derivatives (skipped when the clamped value is unchanged). Interpolates cached tables
-    /// (docs/bsdfs.md (46)): microseconds, plus 6–10 ms for each node α not met before.
+    /// (docs/bsdfs.md (46)): microseconds, plus 40–90 ms for each node α not met before.
     /// Non-finite values throw std::invalid_argument.
     void set_scalar(const std::string& key, float value) override {
         if (key != "alpha") BSDF<N>::set_scalar(key, value);
@@ -79,8 +83,8 @@ public:
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
         Vec3f h = (wi + wo).normalized();
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);  // docs/bsdfs.md (25)
-        if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
-        float diff = m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o;
+        if (spec != 0.f) spec *= specular_fresnel(wi, h);
+        float diff = m_inv_eta2 * transmittance(cos_i) * transmittance_out(cos_o) * kInvPi * cos_o;
         return m_specular * spec + m_substrate.base(ctx) * diff;
     }
 
@@ -132,10 +136,10 @@ public:
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
         if (key < m_substrate.key_count())
             return m_substrate.d_base(ctx, key) *
-                   (m_inv_eta2 * transmittance(cos_i) * transmittance(cos_o) * kInvPi * cos_o);
+                   (m_inv_eta2 * transmittance(cos_i) * transmittance_out(cos_o) * kInvPi * cos_o);
         Vec3f h = (wi + wo).normalized();
         float spec = m_distr.D(h) * m_distr.G(wi, wo, h) / (4.f * cos_i);
-        if (spec != 0.f) spec *= fresnel_dielectric(wi.dot(h), m_eta).R;
+        if (spec != 0.f) spec *= specular_fresnel(wi, h);
         return Spectrum<N>::Constant(spec);
     }
 
@@ -150,6 +154,8 @@ public:
     /// and path replay holds bs.wo and bs.pdf fixed (docs/bsdfs.md (43)).
     Spectrum<N> eval_grad_scalar(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo, int key) const override {
         if (key != 0) throw std::invalid_argument("roughplastic: scalar key index out of range");
+        if (m_cycles_approximation)  // the R/A table's own α-derivative is not tabulated
+            throw std::logic_error("roughplastic: cycles_approximation has no roughness derivative");
         float cos_i = cos_theta(wi), cos_o = cos_theta(wo);
         if (cos_i <= 0.f || cos_o <= 0.f) return Spectrum<N>::Zero();
         Vec3f h = (wi + wo).normalized();
@@ -176,14 +182,31 @@ private:
             df += inside.dt[j] * mu;
         }
         m_substrate.set_internal_reflectance(float(2.0 * f / kTransmittanceRes), float(2.0 * df / kTransmittanceRes));
+        if (m_cycles_approximation) rebuild_cycles_ratio();
+    }
+    // docs/bsdfs.md (49): R(μ_j) / A_glossy(μ_j), the factor that gives a Fresnel-free lobe
+    // Mitsuba's specular albedo; μ_0 = 0 takes μ_1's value, as the translation does.
+    void rebuild_cycles_ratio() {
+        const TransmittanceTable r = rough_lobe_table_direct(m_distr.type(), m_eta, m_distr.alpha(), CoatingLobe::Reflection);
+        const TransmittanceTable a = rough_lobe_table_direct(m_distr.type(), m_eta, m_distr.alpha(), CoatingLobe::Glossy);
+        for (int j = 0; j < kTransmittanceRes; ++j) m_cycles_ratio[j] = a.t[j] > 1e-6f ? r.t[j] / a.t[j] : 0.f;
+        m_cycles_ratio[0] = m_cycles_ratio[1];
     }
     float transmittance(float mu) const { return interpolate_mu(m_tables.t, mu); }
+    /// t(cos θo), or its cosine-weighted mean T̄ under cycles_approximation (docs/bsdfs.md (49)).
+    float transmittance_out(float cos_o) const { return m_cycles_approximation ? m_tables.mean : transmittance(cos_o); }
+    /// R(wi·h), or R(μ_i)/A_glossy(μ_i) at the macro normal under cycles_approximation.
+    float specular_fresnel(const Vec3f& wi, const Vec3f& h) const {
+        return m_cycles_approximation ? interpolate_mu(m_cycles_ratio, cos_theta(wi)) : fresnel_dielectric(wi.dot(h), m_eta).R;
+    }
 
     MicrofacetDistribution m_distr;
     float m_eta, m_inv_eta2 = 1.f;
     PlasticSubstrate<N> m_substrate;  ///< ρ̃ after internal bounces, docs/bsdfs.md (23)
     Spectrum<N> m_specular;
     TransmittanceTable m_tables;  ///< t(mu_j), ∂t/∂α(mu_j), T̄, ∂T̄/∂α at the current alpha
+    bool m_cycles_approximation;
+    std::array<float, kTransmittanceRes> m_cycles_ratio{};  ///< R/A_glossy, only with cycles_approximation
 };
 
 }  // namespace
