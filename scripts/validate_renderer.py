@@ -122,21 +122,51 @@ def render_once(kind, args, scene_path, out_exr, seed, extra, log):
 APPROXIMATED_BSDFS = ("plastic", "roughplastic", "roughconductor")
 
 
-def approximated_scene(scene_path, folder):
-    """A copy of the scene XML with cycles_approximation on every plastic, roughplastic and
-    roughconductor, in <folder>/approximated/ beside links to everything else of the scene's folder
-    (meshes and textures are named relative to the XML). Returns its path and how many BSDFs it
-    changed."""
-    with open(scene_path) as f:
-        text = f.read()
+def with_approximations(text):
+    """The scene XML with cycles_approximation on every plastic, roughplastic and roughconductor, and
+    how many BSDFs that changed."""
     flag = '<boolean name="cycles_approximation" value="true"/>'
     pattern = re.compile(r'<bsdf\b([^>]*\btype\s*=\s*"(?:%s)"[^>]*?)(/?)>' % "|".join(APPROXIMATED_BSDFS))
 
     def add_flag(m):
         return "<bsdf%s>%s%s" % (m.group(1), flag, "</bsdf>" if m.group(2) else "")
 
-    text, changed = pattern.subn(add_flag, text)
-    out_dir = os.path.join(folder, "approximated")
+    return pattern.subn(add_flag, text)
+
+
+def with_face_normals(text):
+    """The scene XML with face_normals true on every obj and ply shape (flat shading: shading normal =
+    geometric normal in both renderers), and how many shapes that changed."""
+    pattern = re.compile(r'(<shape\b[^>]*\btype\s*=\s*"(?:obj|ply)"[^>]*>)(.*?)(</shape>)', re.S)
+    existing = re.compile(r'(<boolean\b[^>]*\bname\s*=\s*"face_normals"[^>]*\bvalue\s*=\s*")[^"]*(")')
+
+    def flatten(m):
+        body, n = existing.subn(r"\1true\2", m.group(2))
+        if n == 0:
+            body = '<boolean name="face_normals" value="true"/>' + body
+        return m.group(1) + body + m.group(3)
+
+    return pattern.subn(flatten, text)
+
+
+def with_box_filter(text):
+    """The scene XML with every <rfilter> a box (Cycles has one exactly; Mitsuba's tent it only
+    approximates by a Gaussian of the same variance), and how many filters that changed."""
+    return re.subn(r'(<rfilter\b[^>]*\btype\s*=\s*")(?!box")[^"]*(")', r"\1box\2", text)
+
+
+def scene_variant(scene_path, folder, name, approximate=False, flat=False, box=False):
+    """A rewritten copy of the scene XML (with_approximations, with_face_normals, with_box_filter) in
+    <folder>/<name>/ beside links to everything else of the scene's folder (meshes and textures are
+    named relative to the XML). Returns its path and how many BSDFs and meshes it changed."""
+    with open(scene_path) as f:
+        text = f.read()
+    changed = {"bsdfs": 0, "meshes": 0, "filters": 0}
+    for wanted, rewrite, kind in ((approximate, with_approximations, "bsdfs"), (flat, with_face_normals, "meshes"),
+                                  (box, with_box_filter, "filters")):
+        if wanted:
+            text, changed[kind] = rewrite(text)
+    out_dir = os.path.join(folder, name)
     os.makedirs(out_dir, exist_ok=True)
     src_dir = os.path.dirname(os.path.abspath(scene_path))
     for entry in os.listdir(src_dir):
@@ -187,6 +217,11 @@ def main():
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--force", action="store_true", help="re-render even where finished renders exist")
     ap.add_argument("-D", dest="defines", action="append", default=[], help="scene override for both renderers, e.g. max_depth=6")
+    ap.add_argument("--flat-shading", action="store_true",
+                    help="both renderers render every obj/ply mesh with face normals (a rewritten copy of the scene): "
+                         "separates how the renderers treat smooth shading normals from the rest")
+    ap.add_argument("--box-filter", action="store_true",
+                    help="both renderers use a box pixel filter (a rewritten copy of the scene): Cycles has no tent")
     ap.add_argument("--split", action="store_true",
                     help="also render ours as the Cycles translation approximates plastic, roughplastic and roughconductor "
                          "(seeds 3 and 4) and compare it with ours and with Cycles (docs/validation.md)")
@@ -203,13 +238,16 @@ def main():
     for name in [s for s in args.scenes.split(",") if s]:
         if name not in SCENES:
             sys.exit("validate: unknown scene '%s' (known: %s)" % (name, ", ".join(SCENES)))
-        scene_path = os.path.join(shared_dir(), "scenes", SCENES[name])
-        if not os.path.exists(scene_path):
-            sys.exit("validate: %s not found (set LATENTPT_SHARED)" % scene_path)
+        original = os.path.join(shared_dir(), "scenes", SCENES[name])
+        if not os.path.exists(original):
+            sys.exit("validate: %s not found (set LATENTPT_SHARED)" % original)
         folder = os.path.join(args.out, name)
         os.makedirs(folder, exist_ok=True)
+        rewrites = {"flat": args.flat_shading, "box": args.box_filter}
+        scene_path = scene_variant(original, folder, "rewritten", **rewrites)[0] if any(rewrites.values()) else original
         log = os.path.join(folder, "log.txt")
-        entry = {"scene": name, "file": SCENES[name], "res": args.res, "spp": args.spp, "defines": args.defines}
+        entry = {"scene": name, "file": SCENES[name], "res": args.res, "spp": args.spp, "defines": args.defines,
+                 "flat_shading": args.flat_shading, "box_filter": args.box_filter}
 
         def render_pair(kind, label=None, path=scene_path, seeds=(1, 2)):
             """Both seeds of one renderer; returns their files and seconds."""
@@ -224,8 +262,8 @@ def main():
 
         ours, entry["seconds_ours"] = render_pair("ours")
         if args.split:
-            approx_path, changed = approximated_scene(scene_path, folder)
-            entry["approximated_bsdfs"] = changed
+            approx_path, changed = scene_variant(original, folder, "approximated", approximate=True, **rewrites)
+            entry["approximated_bsdfs"] = changed["bsdfs"]
             approx, entry["seconds_ours_approximated"] = render_pair("ours", "ours_approximated", approx_path, (3, 4))
             entry["translation"] = compare(args, log, ours, approx, scene_path, os.path.join(folder, "translation"), extra)
         if have_blender:
@@ -260,6 +298,10 @@ def write_summary(out, summary, have_blender):
         if "approximated" in e:
             lines.append(row("%s: ours approximated / Cycles" % e["scene"], e["approximated"], ""))
     text = "\n".join(lines) + "\n"
+    if any(e.get("flat_shading") for e in summary):
+        text += "\nFlat shading (--flat-shading): both renderers rendered every obj/ply mesh with face normals.\n"
+    if any(e.get("box_filter") for e in summary):
+        text += "\nBox filter (--box-filter): both renderers used a box pixel filter.\n"
     if not have_blender:
         text += "\nNo Blender on this machine: only our renders were made.\n"
     for e in summary:
