@@ -187,8 +187,10 @@ private:
     // docs/bsdfs.md (49): R(μ_j) / A_glossy(μ_j), the factor that gives a Fresnel-free lobe
     // Mitsuba's specular albedo; μ_0 = 0 takes μ_1's value, as the translation does.
     void rebuild_cycles_ratio() {
-        const TransmittanceTable r = rough_lobe_table_direct(m_distr.type(), m_eta, m_distr.alpha(), CoatingLobe::Reflection);
-        const TransmittanceTable a = rough_lobe_table_direct(m_distr.type(), m_eta, m_distr.alpha(), CoatingLobe::Glossy);
+        const TransmittanceTable r =
+            rough_lobe_table_direct(m_distr.type(), m_eta, m_distr.alpha(), CoatingLobe::Reflection);
+        const TransmittanceTable a =
+            rough_lobe_table_direct(m_distr.type(), m_eta, m_distr.alpha(), CoatingLobe::Glossy);
         for (int j = 0; j < kTransmittanceRes; ++j) m_cycles_ratio[j] = a.t[j] > 1e-6f ? r.t[j] / a.t[j] : 0.f;
         m_cycles_ratio[0] = m_cycles_ratio[1];
     }
@@ -197,7 +199,8 @@ private:
     float transmittance_out(float cos_o) const { return m_cycles_approximation ? m_tables.mean : transmittance(cos_o); }
     /// R(wi·h), or R(μ_i)/A_glossy(μ_i) at the macro normal under cycles_approximation.
     float specular_fresnel(const Vec3f& wi, const Vec3f& h) const {
-        return m_cycles_approximation ? interpolate_mu(m_cycles_ratio, cos_theta(wi)) : fresnel_dielectric(wi.dot(h), m_eta).R;
+        return m_cycles_approximation ? interpolate_mu(m_cycles_ratio, cos_theta(wi))
+                                      : fresnel_dielectric(wi.dot(h), m_eta).R;
     }
 
     MicrofacetDistribution m_distr;

@@ -40,9 +40,12 @@ Albedo paired_difference(const BSDF<3>& a, const BSDF<3>& b, const Vec3f& wi, in
 const std::vector<Props> kCoatings = {
     props("plastic", {{"int_ior", 1.5f}, {"diffuse_reflectance", rgb(0.8f, 0.4f, 0.1f)}}),
     props("plastic", {{"int_ior", 1.5f}, {"nonlinear", true}, {"diffuse_reflectance", rgb(1.f, 1.f, 1.f)}}),
-    props("roughplastic", {{"alpha", 0.1f}, {"int_ior", 1.5f}, {"nonlinear", true}, {"diffuse_reflectance", rgb(1.f, 1.f, 1.f)}}),
     props("roughplastic",
-          {{"distribution", std::string("ggx")}, {"alpha", 0.2f}, {"int_ior", 1.5f}, {"diffuse_reflectance", rgb(0.05f, 0.3f, 0.6f)}}),
+          {{"alpha", 0.1f}, {"int_ior", 1.5f}, {"nonlinear", true}, {"diffuse_reflectance", rgb(1.f, 1.f, 1.f)}}),
+    props("roughplastic", {{"distribution", std::string("ggx")},
+                           {"alpha", 0.2f},
+                           {"int_ior", 1.5f},
+                           {"diffuse_reflectance", rgb(0.05f, 0.3f, 0.6f)}}),
     props("roughplastic", {{"alpha", 0.5f}, {"int_ior", 1.33f}, {"diffuse_reflectance", rgb(0.5f, 0.5f, 0.5f)}}),
 };
 
@@ -83,7 +86,8 @@ TEST(CyclesApproximation, CoatingsMoveEnergyTowardGrazingLight) {
 
 TEST(CyclesApproximation, SamplingStaysConsistent) {
     std::vector<Props> all = kCoatings;
-    all.push_back(props("roughconductor", {{"alpha", 0.3f}, {"eta", rgb(0.2f, 0.9f, 1.1f)}, {"k", rgb(3.9f, 2.4f, 2.2f)}}));
+    all.push_back(
+        props("roughconductor", {{"alpha", 0.3f}, {"eta", rgb(0.2f, 0.9f, 1.1f)}, {"k", rgb(3.9f, 2.4f, 2.2f)}}));
     const std::vector<Vec3f> wis = {dir(0.9f, 0.3f), dir(0.4f, 1.f), dir(0.15f, 2.f)};
     for (const Props& p : all) {
         const Props q = with_approximation(p);
@@ -130,7 +134,8 @@ TEST(CyclesApproximation, GlossyTableIsTheFresnelFreeLobesAlbedo) {
             for (int j : {8, 32, 63}) {
                 const float mu = float(j) / (kTransmittanceRes - 1);
                 const Albedo s = albedo(*mirror, dir(mu, 0.3f), TransportMode::Radiance, 400000);
-                EXPECT_NEAR(a.t[j], s.mean, 4.0 * s.se + 2e-4) << (type == MicrofacetType::GGX ? "ggx" : "beckmann") << " alpha " << alpha << ", mu " << mu;
+                EXPECT_NEAR(a.t[j], s.mean, 4.0 * s.se + 2e-4)
+                    << (type == MicrofacetType::GGX ? "ggx" : "beckmann") << " alpha " << alpha << ", mu " << mu;
             }
         }
 }
