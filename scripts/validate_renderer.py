@@ -91,11 +91,17 @@ def fingerprint(path):
     return _FINGERPRINTS[path]
 
 
+def content_sha1(path):
+    """SHA-1 of a scene file as it is now: the rewritten copies keep their paths across flags."""
+    with open(path, "rb") as f:
+        return hashlib.sha1(f.read()).hexdigest()
+
+
 def render_once(kind, args, scene_path, out_exr, seed, extra, log):
     """Renders unless out_exr exists with the same settings and code (kept in out_exr + '.settings')."""
     tool = args.bin if kind == "ours" else os.path.join(ROOT, "tools", "cycles_reference.py")
-    settings = {"kind": kind, "scene": scene_path, "res": args.res, "spp": args.spp // 2, "seed": seed, "extra": extra,
-                "code": fingerprint(tool)}
+    settings = {"kind": kind, "scene": scene_path, "scene_sha1": content_sha1(scene_path), "res": args.res,
+                "spp": args.spp // 2, "seed": seed, "extra": extra, "code": fingerprint(tool)}
     stamp = out_exr + ".settings"
     if not args.force and os.path.exists(out_exr) and os.path.exists(stamp):
         with open(stamp) as f:
@@ -120,6 +126,22 @@ def render_once(kind, args, scene_path, out_exr, seed, extra, log):
 
 
 APPROXIMATED_BSDFS = ("plastic", "roughplastic", "roughconductor")
+COMMENT = re.compile(r"<!--.*?-->", re.S)
+
+
+def outside_comments(text, pattern, replace):
+    """pattern.sub(replace) on the parts of an XML text that are not <!-- comments --> (the paper's
+    scenes keep whole alternatives commented out), and the number of replacements."""
+    parts, count, last = [], 0, 0
+    for m in list(COMMENT.finditer(text)) + [None]:
+        chunk = text[last:m.start() if m else len(text)]
+        chunk, n = pattern.subn(replace, chunk)
+        parts.append(chunk)
+        count += n
+        if m:
+            parts.append(m.group(0))
+            last = m.end()
+    return "".join(parts), count
 
 
 def with_approximations(text):
@@ -127,32 +149,30 @@ def with_approximations(text):
     how many BSDFs that changed."""
     flag = '<boolean name="cycles_approximation" value="true"/>'
     pattern = re.compile(r'<bsdf\b([^>]*\btype\s*=\s*"(?:%s)"[^>]*?)(/?)>' % "|".join(APPROXIMATED_BSDFS))
-
-    def add_flag(m):
-        return "<bsdf%s>%s%s" % (m.group(1), flag, "</bsdf>" if m.group(2) else "")
-
-    return pattern.subn(add_flag, text)
+    return outside_comments(text, pattern,
+                            lambda m: "<bsdf%s>%s%s" % (m.group(1), flag, "</bsdf>" if m.group(2) else ""))
 
 
 def with_face_normals(text):
     """The scene XML with face_normals true on every obj and ply shape (flat shading: shading normal =
     geometric normal in both renderers), and how many shapes that changed."""
-    pattern = re.compile(r'(<shape\b[^>]*\btype\s*=\s*"(?:obj|ply)"[^>]*>)(.*?)(</shape>)', re.S)
-    existing = re.compile(r'(<boolean\b[^>]*\bname\s*=\s*"face_normals"[^>]*\bvalue\s*=\s*")[^"]*(")')
+    pattern = re.compile(r'(<shape\b[^>]*\btype\s*=\s*"(?:obj|ply)"[^>]*?(?<!/)>)(.*?)(</shape>)', re.S)
+    existing = re.compile(r'<boolean\b[^>]*\bname\s*=\s*"face_normals"[^>]*>(\s*</boolean>)?')
+    flag = '<boolean name="face_normals" value="true"/>'
 
     def flatten(m):
-        body, n = existing.subn(r"\1true\2", m.group(2))
-        if n == 0:
-            body = '<boolean name="face_normals" value="true"/>' + body
-        return m.group(1) + body + m.group(3)
+        body = existing.sub("", m.group(2))
+        return m.group(1) + flag + body + m.group(3)
 
-    return pattern.subn(flatten, text)
+    return outside_comments(text, pattern, flatten)
 
 
 def with_box_filter(text):
-    """The scene XML with every <rfilter> a box (Cycles has one exactly; Mitsuba's tent it only
-    approximates by a Gaussian of the same variance), and how many filters that changed."""
-    return re.subn(r'(<rfilter\b[^>]*\btype\s*=\s*")(?!box")[^"]*(")', r"\1box\2", text)
+    """The scene XML with every <rfilter> a box of Mitsuba's default radius (Cycles has one exactly;
+    Mitsuba's tent it only approximates by a Gaussian of the same variance), and how many filters
+    that changed."""
+    pattern = re.compile(r'<rfilter\b[^>]*?(/>|>.*?</rfilter>)', re.S)
+    return outside_comments(text, pattern, lambda m: '<rfilter type="box"/>')
 
 
 def scene_variant(scene_path, folder, name, approximate=False, flat=False, box=False):
@@ -166,6 +186,8 @@ def scene_variant(scene_path, folder, name, approximate=False, flat=False, box=F
                                   (box, with_box_filter, "filters")):
         if wanted:
             text, changed[kind] = rewrite(text)
+            if changed[kind] == 0:  # a rewrite that found nothing would compare the scene with itself
+                sys.exit("validate: %s has no %s to rewrite for '%s'" % (scene_path, kind, name))
     out_dir = os.path.join(folder, name)
     os.makedirs(out_dir, exist_ok=True)
     src_dir = os.path.dirname(os.path.abspath(scene_path))

@@ -19,14 +19,15 @@ import validate_renderer as V  # noqa: E402
 BIN = None
 
 SCENE = """<scene version="3.0.0">
-  <sensor type="perspective"><film type="hdrfilm"><rfilter type="tent"/></film></sensor>
+  <sensor type="perspective"><film type="hdrfilm"><rfilter type="tent"><float name="radius" value="2"/></rfilter></film></sensor>
+  <!-- <bsdf type="roughconductor" id="old"/> <shape type="obj" id="old"><string name="filename" value="x.obj"/></shape> -->
   <bsdf type="twosided" id="a"><bsdf type="roughplastic"><float name="alpha" value="0.1"/></bsdf></bsdf>
   <bsdf type="plastic" id="b"/>
   <bsdf type="roughconductor" id="c" ><float name="alpha" value="0.2"/></bsdf>
   <bsdf type="diffuse" id="d"/>
   <bsdf type="roughdielectric" id="e"/>
   <shape type="obj" id="m1"><string name="filename" value="a.obj"/></shape>
-  <shape type="ply" id="m2"><boolean name="face_normals" value="false"/><string name="filename" value="b.ply"/></shape>
+  <shape type="ply" id="m2"><boolean value="false" name="face_normals"/><string name="filename" value="b.ply"/></shape>
   <shape type="rectangle" id="r"/>
 </scene>
 """
@@ -44,19 +45,20 @@ class Rewrites(unittest.TestCase):
         self.assertEqual(sorted(bsdf_with_flag(text)), ["plastic", "roughconductor", "roughplastic"])
         self.assertIn('<bsdf type="plastic" id="b"><boolean name="cycles_approximation" value="true"/></bsdf>', text)
         self.assertEqual(text.count("cycles_approximation"), 3)
+        self.assertIn('<!-- <bsdf type="roughconductor" id="old"/>', text, "comments stay as they are")
 
     def test_face_normals_on_every_mesh_and_only_meshes(self):
         text, n = V.with_face_normals(SCENE)
         self.assertEqual(n, 2)
         self.assertEqual(text.count('name="face_normals" value="true"'), 2)
+        self.assertEqual(text.count("face_normals"), 2, "one key per mesh, whatever the attribute order")
         self.assertNotIn('value="false"', text)
         self.assertIn('<shape type="rectangle" id="r"/>', text)
 
     def test_box_filter(self):
         text, n = V.with_box_filter(SCENE)
         self.assertEqual(n, 1)
-        self.assertIn('<rfilter type="box"/>', text)
-        self.assertEqual(V.with_box_filter(text)[1], 0)
+        self.assertIn('<film type="hdrfilm"><rfilter type="box"/></film>', text, "the tent's radius goes too")
 
     def test_paper_scenes_load_rewritten(self):
         shared = os.environ.get("LATENTPT_SHARED", os.path.join(ROOT, "..", "shared"))
