@@ -4,7 +4,8 @@
 // translation changes and what is left (docs/validation.md, "Splitting a difference";
 // docs/bsdfs.md (47)-(49)). Blender 3.4's shader nodes see only the view direction, never the
 // light's, so the translation replaces each factor of the light direction θo by its
-// cosine-weighted mean, and evaluates Fresnel terms at the macro normal. With this key our
+// cosine-weighted mean, takes the rough conductor's Fresnel at the macro normal, and gives
+// roughplastic's Fresnel-free specular lobe Mitsuba's albedo per view angle. With this key our
 // renders make the same replacements and nothing else.
 // RGB only: the latent renderer and the fit refuse it (they would fit a different model).
 #pragma once

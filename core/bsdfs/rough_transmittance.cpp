@@ -21,9 +21,8 @@ struct RawTables {
 
 // The lobe's direction for microfacet m and its Fresnel factor: reflection with R, refraction
 // with 1 − R (Mitsuba's eval_reflectance / eval_transmittance integrands), the Fresnel-free
-// reflection with 1; false where the lobe
-// has no direction on its side (below the surface for reflection, total internal reflection or
-// back above it for refraction).
+// reflection with 1; false where the lobe has no direction on its side (below the surface for
+// reflection, total internal reflection or back above it for refraction).
 bool lobe_direction(const Vec3f& wi, const Vec3f& m, float eta, CoatingLobe lobe, Vec3f& wo, double& fresnel) {
     const FresnelDielectric f = fresnel_dielectric(wi.dot(m), eta);
     if (lobe != CoatingLobe::Transmission) {
@@ -38,14 +37,11 @@ bool lobe_direction(const Vec3f& wi, const Vec3f& m, float eta, CoatingLobe lobe
 }
 
 // The sampler's first coordinate u1 = 1 − (1 − v)² for a midpoint grid in v, and du1/dv. Both
-// samplers put the microfacets' tail (the steepest normals) at u1 → 1, and there reflection
-// sends wo below the horizon: a discontinuity a plain grid in u1 cannot place. GGX's tail is
-// heavy (a fraction α²/(1 + α²) of its normals, at normal incidence, tilt beyond 45°), and
-// with a 32² grid in u the Fresnel-free albedo at α = 0.1 came out 0.998 where the integral is
-// 0.988, T̄ 0.07 % and the internal reflectance 0.7 % too high. On 64² in v every table entry
-// agrees with tools/cycles_reference.py's independent 384×192 Gauss-Legendre integration in
-// tan θm to about 1e-4 (docs/bsdfs.md (26)). For Beckmann, d ln D/dα also grows like −ln(1 − u1)
-// toward u1 = 1, and (1 − v) ln(1 − v) → 0 smooths it.
+// samplers put the steepest microfacets at u1 → 1, where reflection sends wo below the horizon:
+// a discontinuity that a plain grid in u1 never reaches for GGX, whose tail is heavy (a fraction
+// α²/(1 + α²) of its normals tilt beyond 45° at normal incidence; docs/bsdfs.md (26) has what
+// that cost). For Beckmann, d ln D/dα also grows like −ln(1 − u1) toward u1 = 1, and
+// (1 − v) ln(1 − v) → 0 smooths it.
 struct TailNode {
     double u1, jacobian;
 };
@@ -101,9 +97,10 @@ RawTables raw_tables(MicrofacetType type, float eta, float alpha, CoatingLobe lo
     MicrofacetDistribution distr(type, alpha);
     // The transmittance's ∂/∂α comes from central differences of its own quadrature in ln α
     // (the sample points move smoothly with α). The derivative integral, used for A, converges
-    // far too slowly for T on this grid: d ln D/dα grows like tan²θm/α² on tilted microfacets,
-    // which reflection sends below the horizon but refraction keeps (32×32: 45 % off T̄'s slope
-    // for Beckmann at α = 0.1, 128×128: 3.5 %). At the α floor the difference is one-sided.
+    // far too slowly for T: d ln D/dα grows like tan²θm/α² on tilted microfacets, which
+    // reflection sends below the horizon but refraction keeps (on plain grids in u, 32×32: 45 %
+    // off T̄'s slope for Beckmann at α = 0.1, 128×128: 3.5 %). At the α floor the difference is
+    // one-sided.
     const double up = std::exp(kSlopeStep),
                  down = std::max(std::exp(-kSlopeStep), MicrofacetDistribution::kMinAlpha / double(alpha));
     MicrofacetDistribution distr_up(type, float(alpha * up)), distr_down(type, float(alpha * down));
