@@ -301,14 +301,14 @@ inline void expect_reciprocal(const Props& p, bool both_sides, float eta = 1.f, 
 struct Albedo {
     double mean = 0.0, se = 0.0;
 };
-inline Albedo albedo(const BSDF<3>& bsdf, const Vec3f& wi, TransportMode mode, int n = 100000) {
-    BSDFContext ctx = context(mode);
-    Rng rng(3);
+/// Mean and standard error of f(u1, u2) over n draws of Rng(seed) (u1 drawn first).
+template <typename F>
+Albedo sample_mean(uint64_t seed, int n, F&& f) {
+    Rng rng(seed);
     double sum = 0.0, sum2 = 0.0;
     for (int i = 0; i < n; ++i) {
         float u1 = rng.next();
-        BSDFSample<3> bs = bsdf.sample(ctx, wi, u1, rng.next2());
-        double w = bs.valid() ? double(bs.weight.mean()) : 0.0;
+        double w = f(u1, rng.next2());
         sum += w;
         sum2 += w * w;
     }
@@ -316,6 +316,16 @@ inline Albedo albedo(const BSDF<3>& bsdf, const Vec3f& wi, TransportMode mode, i
     a.mean = sum / n;
     a.se = std::sqrt(std::max(0.0, sum2 / n - a.mean * a.mean) / (n - 1));
     return a;
+}
+/// A sample's mean weight, 0 for a failed sample.
+inline double sample_weight_mean(const BSDF<3>& bsdf, const BSDFContext& ctx, const Vec3f& wi, float u1,
+                                 const Vec2f& u2) {
+    BSDFSample<3> bs = bsdf.sample(ctx, wi, u1, u2);
+    return bs.valid() ? double(bs.weight.mean()) : 0.0;
+}
+inline Albedo albedo(const BSDF<3>& bsdf, const Vec3f& wi, TransportMode mode, int n = 100000) {
+    const BSDFContext ctx = context(mode);
+    return sample_mean(3, n, [&](float u1, const Vec2f& u2) { return sample_weight_mean(bsdf, ctx, wi, u1, u2); });
 }
 inline void expect_energy(const Props& p, const std::vector<Vec3f>& wis, TransportMode mode, double lower = 0.0) {
     auto bsdf = make_bsdf<3>(p);

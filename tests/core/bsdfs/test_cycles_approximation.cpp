@@ -20,21 +20,10 @@ Props with_approximation(Props p) {
 /// Mean and standard error of a's sample weight minus b's, both sampled with the same numbers
 /// (the two BSDFs sample alike, so the noise they share cancels).
 Albedo paired_difference(const BSDF<3>& a, const BSDF<3>& b, const Vec3f& wi, int n = 100000) {
-    BSDFContext ctx;
-    Rng rng(5);
-    double sum = 0.0, sum2 = 0.0;
-    for (int i = 0; i < n; ++i) {
-        const float u1 = rng.next();
-        const Vec2f u2 = rng.next2();
-        const BSDFSample<3> sa = a.sample(ctx, wi, u1, u2), sb = b.sample(ctx, wi, u1, u2);
-        const double d = (sa.valid() ? double(sa.weight.mean()) : 0.0) - (sb.valid() ? double(sb.weight.mean()) : 0.0);
-        sum += d;
-        sum2 += d * d;
-    }
-    Albedo r;
-    r.mean = sum / n;
-    r.se = std::sqrt(std::max(0.0, sum2 / n - r.mean * r.mean) / (n - 1));
-    return r;
+    const BSDFContext ctx;
+    return sample_mean(5, n, [&](float u1, const Vec2f& u2) {
+        return sample_weight_mean(a, ctx, wi, u1, u2) - sample_weight_mean(b, ctx, wi, u1, u2);
+    });
 }
 
 const std::vector<Props> kCoatings = {
