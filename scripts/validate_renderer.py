@@ -76,25 +76,25 @@ def blender_env(blender):
     return env
 
 
+def content_sha1(path):
+    """SHA-1 of a file as it is now (a scene file: the rewritten copies keep their paths across
+    flags)."""
+    h = hashlib.sha1()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
 _FINGERPRINTS = {}
 
 
 def fingerprint(path):
-    """SHA-1 of a file (the latentpt binary, the translation script): a render made by other code
-    is not a finished render of this run."""
+    """content_sha1 of the code that renders (the latentpt binary, the translation script), once per
+    run: a render made by other code is not a finished render of this run."""
     if path not in _FINGERPRINTS:
-        h = hashlib.sha1()
-        with open(path, "rb") as f:
-            for chunk in iter(lambda: f.read(1 << 20), b""):
-                h.update(chunk)
-        _FINGERPRINTS[path] = h.hexdigest()
+        _FINGERPRINTS[path] = content_sha1(path)
     return _FINGERPRINTS[path]
-
-
-def content_sha1(path):
-    """SHA-1 of a scene file as it is now: the rewritten copies keep their paths across flags."""
-    with open(path, "rb") as f:
-        return hashlib.sha1(f.read()).hexdigest()
 
 
 def render_once(kind, args, scene_path, out_exr, seed, extra, log):
