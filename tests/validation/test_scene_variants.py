@@ -3,7 +3,6 @@
 difference"): cycles_approximation lands on plastic, roughplastic and roughconductor and nowhere
 else, face_normals and the box filter replace what was there, and latentpt loads every rewritten
 copy of a paper scene (when ../shared is present)."""
-import argparse
 import os
 import re
 import subprocess
@@ -16,7 +15,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import validate_renderer as V  # noqa: E402
 
-BIN = None
+BIN = os.environ.get("LATENTPT_BIN")  # ctest sets it to the built latentpt
 
 SCENE = """<scene version="3.0.0">
   <sensor type="perspective"><film type="hdrfilm"><rfilter type="tent"><float name="radius" value="2"/></rfilter></film></sensor>
@@ -79,8 +78,4 @@ class Rewrites(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--bin", default=None)
-    args, rest = ap.parse_known_args()
-    BIN = args.bin
-    unittest.main(argv=[sys.argv[0]] + rest)
+    unittest.main()
