@@ -16,6 +16,7 @@ sidecar JSON): process start-up and scene translation are left out on both sides
 
     python3 scripts/bench_equal_noise.py                       # cornell-box, 256x256
     python3 scripts/bench_equal_noise.py --scene cbox-specular
+    python3 scripts/bench_equal_noise.py --scene cbox-specular --diffuse-mirrors
 
 Outputs <out>/<scene>/report.md and report.json (written atomically); Cycles renders and the
 cached reference are kept and reused when rerun with the same settings and code (--force redoes
@@ -33,7 +34,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from validate_renderer import blender_env, fingerprint, shared_dir  # noqa: E402
+from validate_renderer import blender_env, content_sha1, fingerprint, scene_variant, shared_dir  # noqa: E402
 
 SCENES = {  # name -> (scene file, converged reference under <shared>/scenes or None)
     "cornell-box": ("cornell-box/scene_v3.xml", "cornell-box/TungstenRender.exr"),
@@ -67,7 +68,7 @@ def cached(path, settings, force):
 def render(kind, args, scene, spp, seed, path):
     """Renders unless cached; returns render seconds (the renderer's own count)."""
     tool = os.path.join(ROOT, "tools", "cycles_reference.py") if kind == "cycles" else args.bin
-    settings = {"kind": kind, "scene": scene, "res": args.res, "spp": spp, "seed": seed, "code": fingerprint(tool)}
+    settings = {"kind": kind, "scene": scene, "scene_sha1": content_sha1(scene), "res": args.res, "spp": spp, "seed": seed, "code": fingerprint(tool)}
     old = cached(path, settings, args.force)
     if old:
         return old["seconds"]
@@ -123,6 +124,9 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "apps", "latentpt"))
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--no-cycles", action="store_true", help="leave the Cycles column empty")
+    ap.add_argument("--diffuse-mirrors", action="store_true",
+                    help="smooth conductors made diffuse (a rewritten copy of the scene, its own reference): "
+                         "how much of the noise is light that mirrors reflect onto diffuse surfaces")
     ap.add_argument("--force", action="store_true")
     args = ap.parse_args()
 
@@ -130,8 +134,12 @@ def main():
     scene = os.path.join(shared_dir(), "scenes", scene_rel)
     if not os.path.exists(scene):
         sys.exit("bench_equal_noise: %s not found (set LATENTPT_SHARED)" % scene)
-    folder = os.path.join(args.out, args.scene)
+    name = args.scene + ("-diffuse-mirrors" if args.diffuse_mirrors else "")
+    folder = os.path.join(args.out, name)
     os.makedirs(folder, exist_ok=True)
+    if args.diffuse_mirrors:
+        scene, _ = scene_variant(scene, folder, "scene", diffuse_mirrors=True)
+        ref_rel = None  # a shipped reference shows the scene with its mirrors
     if ref_rel:
         ref = os.path.join(shared_dir(), "scenes", ref_rel)
         ref_note = "Tungsten reference (%s), box-averaged to %d²" % (ref_rel, args.res)
@@ -167,7 +175,7 @@ def main():
     def cell(v, fmt):
         return fmt % v if v is not None else "–"
 
-    lines = ["# Equal noise: %s, %d², target relMSE %.6f (independent at %d spp)" % (args.scene, args.res, target, args.target_spp), "",
+    lines = ["# Equal noise: %s, %d², target relMSE %.6f (independent at %d spp)" % (name, args.res, target, args.target_spp), "",
              "Reference: %s. %d thread(s); render times only; each ladder point the mean of %d seeds." % (ref_note, args.threads, args.seeds), "",
              "| renderer | spp to target | seconds to target | spp ratio (independent / this) | speed-up vs independent | speed-up vs Cycles |",
              "|---|---|---|---|---|---|"]
@@ -188,7 +196,7 @@ def main():
     text = "\n".join(lines) + "\n"
     write_atomic(os.path.join(folder, "report.md"), text)
     write_atomic(os.path.join(folder, "report.json"), json.dumps(
-        {"scene": args.scene, "res": args.res, "target": target, "target_spp": args.target_spp, "reference": ref_note,
+        {"scene": name, "res": args.res, "target": target, "target_spp": args.target_spp, "reference": ref_note,
          "threads": args.threads, "ladders": ladders, "reach": reach}, indent=1) + "\n")
     print(text)
 

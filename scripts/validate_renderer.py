@@ -175,18 +175,29 @@ def with_box_filter(text):
     return outside_comments(text, pattern, lambda m: '<rfilter type="box"/>')
 
 
-def scene_variant(scene_path, folder, name, approximate=False, flat=False, box=False):
-    """A rewritten copy of the scene XML (with_approximations, with_face_normals, with_box_filter) in
-    <folder>/<name>/ beside links to everything else of the scene's folder (meshes and textures are
-    named relative to the XML). Returns its path and how many BSDFs and meshes it changed."""
+def with_diffuse_mirrors(text):
+    """The scene XML with every smooth conductor (a delta lobe: the light it reflects onto diffuse
+    surfaces is found only by BSDF sampling, never by NEE) replaced by a diffuse BSDF of reflectance
+    0.8 under the same id, and how many BSDFs that changed (docs/sampling.md, "Equal noise")."""
+    pattern = re.compile(r'<bsdf\b([^>]*?)\btype\s*=\s*"conductor"([^>]*?)(/>|>.*?</bsdf>)', re.S)
+    return outside_comments(text, pattern, lambda m: '<bsdf%stype="diffuse"%s><rgb name="reflectance" value="0.8"/></bsdf>'
+                            % (m.group(1), m.group(2)))
+
+
+def scene_variant(scene_path, folder, name, approximate=False, flat=False, box=False, diffuse_mirrors=False):
+    """A rewritten copy of the scene XML (with_approximations, with_face_normals, with_box_filter,
+    with_diffuse_mirrors) in <folder>/<name>/ beside links to everything else of the scene's folder
+    (meshes and textures are named relative to the XML). Returns its path and how many BSDFs, meshes
+    and filters it changed."""
     with open(scene_path) as f:
         text = f.read()
     changed = {"bsdfs": 0, "meshes": 0, "filters": 0}
     for wanted, rewrite, kind in ((approximate, with_approximations, "bsdfs"), (flat, with_face_normals, "meshes"),
-                                  (box, with_box_filter, "filters")):
+                                  (box, with_box_filter, "filters"), (diffuse_mirrors, with_diffuse_mirrors, "bsdfs")):
         if wanted:
-            text, changed[kind] = rewrite(text)
-            if changed[kind] == 0:  # a rewrite that found nothing would compare the scene with itself
+            text, n = rewrite(text)
+            changed[kind] += n
+            if n == 0:  # a rewrite that found nothing would compare the scene with itself
                 sys.exit("validate: %s has no %s to rewrite for '%s'" % (scene_path, kind, name))
     out_dir = os.path.join(folder, name)
     os.makedirs(out_dir, exist_ok=True)

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """scripts/validate_renderer.py's rewritten scene copies (docs/validation.md, "Splitting a
 difference"): cycles_approximation lands on plastic, roughplastic and roughconductor and nowhere
-else, face_normals and the box filter replace what was there, and latentpt loads every rewritten
-copy of a paper scene (when ../shared is present)."""
+else, face_normals and the box filter replace what was there, smooth conductors (and nothing else)
+become diffuse, and latentpt loads every rewritten copy of a paper scene (when ../shared is
+present)."""
 import os
 import re
 import subprocess
@@ -25,6 +26,9 @@ SCENE = """<scene version="3.0.0">
   <bsdf type="roughconductor" id="c" ><float name="alpha" value="0.2"/></bsdf>
   <bsdf type="diffuse" id="d"/>
   <bsdf type="roughdielectric" id="e"/>
+  <bsdf type="conductor" id="f"><rgb name="specular_reflectance" value="1.0"/></bsdf>
+  <bsdf id="g" type="conductor"/>
+  <bsdf type="twosided" id="h"><bsdf type="conductor"><string name="material" value="Au"/></bsdf></bsdf>
   <shape type="obj" id="m1"><string name="filename" value="a.obj"/></shape>
   <shape type="ply" id="m2"><boolean value="false" name="face_normals"/><string name="filename" value="b.ply"/></shape>
   <shape type="rectangle" id="r"/>
@@ -59,6 +63,17 @@ class Rewrites(unittest.TestCase):
         self.assertEqual(n, 1)
         self.assertIn('<film type="hdrfilm"><rfilter type="box"/></film>', text, "the tent's radius goes too")
 
+    def test_diffuse_mirrors_only_smooth_conductors(self):
+        text, n = V.with_diffuse_mirrors(SCENE)
+        self.assertEqual(n, 3)
+        self.assertIn('<bsdf type="diffuse" id="f"><rgb name="reflectance" value="0.8"/></bsdf>', text)
+        self.assertIn('<bsdf id="g" type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf>', text)
+        self.assertIn('<bsdf type="twosided" id="h"><bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf></bsdf>',
+                      text, "a nested conductor ends at its own </bsdf>")
+        self.assertNotIn('type="conductor"', text)
+        self.assertEqual(text.count('type="roughconductor"'), 2, "rough conductors and the comment stay")
+        self.assertNotIn("specular_reflectance", text)
+
     def test_paper_scenes_load_rewritten(self):
         shared = os.environ.get("LATENTPT_SHARED", os.path.join(ROOT, "..", "shared"))
         if BIN is None or not os.path.isdir(os.path.join(shared, "scenes")):
@@ -75,6 +90,13 @@ class Rewrites(unittest.TestCase):
                                    capture_output=True, text=True)
                 self.assertEqual(r.returncode, 0, r.stderr)
                 self.assertTrue(os.path.exists(out))
+            path, changed = V.scene_variant(os.path.join(shared, "scenes", "cbox", "cbox_specular.xml"),
+                                            os.path.join(tmp, "cbox"), "mirrors", diffuse_mirrors=True)
+            self.assertEqual(changed["bsdfs"], 1, "cbox-specular has one mirror (and one commented out)")
+            out = os.path.join(tmp, "cbox.exr")
+            r = subprocess.run([BIN, "render", path, "--res", "16x12", "--spp", "1", "-q", "--out", out],
+                               capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
 
 
 if __name__ == "__main__":
