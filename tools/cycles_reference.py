@@ -9,6 +9,7 @@ no code with latentpt: it exists to check latentpt's renderer against a renderer
 usage:
   blender -b --factory-startup --python tools/cycles_reference.py -- SCENE.xml --out ref.exr
         [--spp N] [--res WxH] [--seed S] [--threads T] [-D name=value ...] [--max-depth N]
+        [--strategy mis|bsdf]
 
   --out FILE        output EXR (float32 RGB, linear, no view transform). Written atomically
                     (rendered to NAME.tmp.exr beside it, then renamed), with a sidecar FILE.json:
@@ -19,6 +20,12 @@ usage:
   --threads T       CPU threads (default 2)
   -D name=value     override an XML <default name value> (repeatable; also -Dname=value)
   --max-depth N     Mitsuba max_depth of the path integrator (default: the XML's)
+  --strategy S      mis (default): emitters and the environment are light-sampled as well as hit
+                    by BSDF sampling, as Mitsuba's path integrator does; bsdf: no light sampling
+                    (every material's "Multiple Importance" off, the world not sampled), so
+                    emission counts only where a BSDF-sampled ray hits it (latentpt render
+                    --strategy bsdf). Both estimate the same image, so a difference
+                    between them is a bias in one of Cycles' two estimators.
   --help            this text
 
 Exit status: 0 on success; 2 when the scene uses something this script cannot translate
@@ -112,7 +119,7 @@ def hard_exit(code):
 
 def parse_args(argv):
     args = {"scene": None, "out": None, "spp": None, "res": None, "seed": 0, "threads": 2,
-            "defines": {}, "max_depth": None}
+            "defines": {}, "max_depth": None, "strategy": "mis"}
     i = 0
 
     def value(opt):
@@ -150,6 +157,10 @@ def parse_args(argv):
             args["threads"] = integer(a, value(a), 1)
         elif a == "--max-depth":
             args["max_depth"] = integer(a, value(a), -1)
+        elif a == "--strategy":
+            args["strategy"] = value(a)
+            if args["strategy"] not in ("mis", "bsdf"):
+                raise SystemExit("error: --strategy expects mis or bsdf, got '%s'" % args["strategy"])
         elif a == "-D" or a.startswith("-D"):
             d = value(a) if a == "-D" else a[2:]
             if "=" not in d or not d.split("=", 1)[0]:
@@ -1921,6 +1932,15 @@ def setup_world(scene_desc, world):
     return {"type": "envmap", "file": fname, "scale": scale, "size": [W, H]}
 
 
+def without_light_sampling(materials, world):
+    """--strategy bsdf: emission is found only by BSDF-sampled rays (no next-event estimation, no
+    MIS weights), like `latentpt render --strategy bsdf`."""
+    for mat in materials:
+        mat.cycles.sample_as_light = False
+    world.cycles.sampling_method = "NONE"
+    note("--strategy bsdf: light sampling off (materials' sample_as_light and the world's sampling)")
+
+
 def setup_camera(sensor, width, height):
     M = np.array(sensor["to_world"], dtype=np.float64)
     R = M[:3, :3]
@@ -2039,7 +2059,7 @@ def configure_render(sc, args, width, height, spp, bounces, film_filter):
         im.color_management = "FOLLOW_SCENE"
     r.use_file_extension = False
     r.use_overwrite = True
-    return {"samples": spp, "seed": args["seed"], "threads": args["threads"], "device": "CPU",
+    return {"samples": spp, "seed": args["seed"], "strategy": args["strategy"], "threads": args["threads"], "device": "CPU",
             "sampling_pattern": cy.sampling_pattern, "max_bounces": bounces,
             "pixel_filter": film_filter[0], "filter_width_px": film_filter[1],
             "clamp_direct": 0.0, "clamp_indirect": 0.0, "filter_glossy": 0.0,
@@ -2125,6 +2145,8 @@ def main():
         note("one-sided Mitsuba BSDFs (not in twosided) are black from the back: gated with Geometry.Backfacing, "
              "which Cycles computes from the geometric normal (Mitsuba uses the shading frame)")
     log("%d shapes, %d triangles, %d materials" % (len(desc.shapes), ntri, len(mb.cache)))
+    if args["strategy"] == "bsdf":
+        without_light_sampling(bpy.data.materials, world)
     settings = configure_render(sc, args, width, height, spp, bounces, film_filter)
     settings.update({"mitsuba_max_depth": max_depth, "width": width, "height": height,
                      "environment": env_info, "camera": cam_info, "defines": args["defines"],
