@@ -191,14 +191,15 @@ def scene_variant(scene_path, folder, name, approximate=False, flat=False, box=F
     and filters it changed."""
     with open(scene_path) as f:
         text = f.read()
-    changed = {"bsdfs": 0, "meshes": 0, "filters": 0}
-    for wanted, rewrite, kind in ((approximate, with_approximations, "bsdfs"), (flat, with_face_normals, "meshes"),
-                                  (box, with_box_filter, "filters"), (diffuse_mirrors, with_diffuse_mirrors, "bsdfs")):
+    changed = {"bsdfs": 0, "meshes": 0, "filters": 0, "mirrors": 0}
+    for wanted, rewrite, kind, what in (
+            (approximate, with_approximations, "bsdfs", "plastic, roughplastic or roughconductor"),
+            (flat, with_face_normals, "meshes", "obj or ply mesh"), (box, with_box_filter, "filters", "rfilter"),
+            (diffuse_mirrors, with_diffuse_mirrors, "mirrors", "smooth conductor")):
         if wanted:
-            text, n = rewrite(text)
-            changed[kind] += n
-            if n == 0:  # a rewrite that found nothing would compare the scene with itself
-                sys.exit("validate: %s has no %s to rewrite for '%s'" % (scene_path, kind, name))
+            text, changed[kind] = rewrite(text)
+            if changed[kind] == 0:  # a rewrite that found nothing would compare the scene with itself
+                sys.exit("%s: no %s to rewrite (for the copy '%s')" % (scene_path, what, name))
     out_dir = os.path.join(folder, name)
     os.makedirs(out_dir, exist_ok=True)
     src_dir = os.path.dirname(os.path.abspath(scene_path))

@@ -40,33 +40,86 @@ def dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
+def obj_index(token, count, where):
+    """0-based vertex index of an OBJ face token ('7', '7/1/2', '-1') among count vertices so far."""
+    try:
+        i = int(token.split("/")[0])
+    except ValueError:
+        fail("%s: field f: '%s' is not a vertex index" % (where, token))
+    if not (1 <= i <= count or -count <= i <= -1):
+        fail("%s: field f: vertex index %d outside 1..%d (or -%d..-1)" % (where, i, count, count))
+    return i - 1 if i > 0 else count + i
+
+
 def read_obj(path):
     """Vertex positions and triangles (fan-triangulated), each triangle with its 'f' line number."""
     verts, tris = [], []
-    with open(path) as f:
-        for number, line in enumerate(f, 1):
-            if line.startswith("v "):
-                verts.append(tuple(float(x) for x in line.split()[1:4]))
-            elif line.startswith("f "):
-                idx = [int(t.split("/")[0]) for t in line.split()[1:]]
-                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
-                tris += [((idx[0], idx[k], idx[k + 1]), number) for k in range(1, len(idx) - 1)]
+    try:
+        with open(path) as f:
+            lines = f.read().splitlines()
+    except OSError as e:
+        fail("%s: %s" % (path, e.strerror or e))
+    for number, line in enumerate(lines, 1):
+        parts = line.split()
+        where = "%s:%d" % (path, number)
+        if parts and parts[0] == "v":
+            try:
+                verts.append(tuple(float(x) for x in parts[1:4]))
+            except ValueError:
+                fail("%s: field v: '%s' is not three numbers" % (where, " ".join(parts[1:4])))
+            if len(verts[-1]) != 3:
+                fail("%s: field v: needs x y z" % where)
+        elif parts and parts[0] == "f":
+            if len(parts) < 4:
+                fail("%s: field f: a face needs at least 3 vertices" % where)
+            idx = [obj_index(t, len(verts), where) for t in parts[1:]]
+            tris += [((idx[0], idx[k], idx[k + 1]), number) for k in range(1, len(idx) - 1)]
     return verts, tris
 
 
+def matmul(a, b):
+    return [[sum(a[r][k] * b[k][c] for k in range(4)) for c in range(4)] for r in range(4)]
+
+
+def transform_step(node, where):
+    """One child of <transform> as a 4x4 matrix: matrix, translate or scale (Mitsuba's attributes),
+    or None for a kind this script does not read."""
+    def number(name, default):
+        try:
+            return float(node.get(name, default))
+        except ValueError:
+            fail("%s: field %s: '%s' is not a number" % (where, name, node.get(name)))
+    if node.tag == "matrix":
+        try:
+            m = [float(v) for v in (node.get("value") or "").replace(",", " ").split()]
+        except ValueError:
+            m = []
+        if len(m) != 16:
+            fail("%s: field to_world: <matrix value> needs 16 numbers" % where)
+        return [m[0:4], m[4:8], m[8:12], m[12:16]]
+    if node.tag == "translate":
+        return [[1, 0, 0, number("x", 0)], [0, 1, 0, number("y", 0)], [0, 0, 1, number("z", 0)], [0, 0, 0, 1]]
+    if node.tag == "scale":
+        v = number("value", 1)
+        return [[number("x", v), 0, 0, 0], [0, number("y", v), 0, 0], [0, 0, number("z", v), 0], [0, 0, 0, 1]]
+    return None
+
+
 def to_world(shape, xml_path):
-    """The shape's 4x4 to_world (identity without one); only <matrix> is read."""
+    """The shape's 4x4 to_world (identity without one), or None when it uses a transform this
+    script does not read (rotate, lookat): the caller skips that shape and says so."""
+    M = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
     t = shape.find("transform[@name='to_world']")
-    if t is None:
-        return [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
-    if len(t) != 1 or t[0].tag != "matrix":
-        fail("%s: shape '%s': field to_world: only a single <matrix> is supported" % (xml_path, shape.get("id")))
-    m = [float(v) for v in t[0].get("value").replace(",", " ").split()]
-    return [m[0:4], m[4:8], m[8:12], m[12:16]]
+    for node in ([] if t is None else list(t)):
+        step = transform_step(node, "%s: shape '%s'" % (xml_path, shape.get("id")))
+        if step is None:
+            return None
+        M = matmul(step, M)  # Mitsuba applies a transform's children in order
+    return M
 
 
 def scene_meshes(xml_path):
-    """(shape id, OBJ path, world-space vertices, triangles) of every obj shape."""
+    """(shape id, OBJ path, world-space vertices, triangles, to_world) of every obj shape."""
     try:
         root = ET.parse(xml_path).getroot()
     except (OSError, ET.ParseError) as e:
@@ -80,9 +133,13 @@ def scene_meshes(xml_path):
             fail("%s: shape '%s': field filename is missing" % (xml_path, shape.get("id")))
         path = os.path.join(os.path.dirname(xml_path), name.get("value"))
         M = to_world(shape, xml_path)
+        if M is None:
+            print("coplanar_faces: %s: shape '%s' skipped: its to_world uses a transform other than matrix, "
+                  "translate or scale" % (xml_path, shape.get("id")), file=sys.stderr)
+            continue
         verts, tris = read_obj(path)
         world = [tuple(sum(M[r][c] * p[c] for c in range(3)) + M[r][3] for r in range(3)) for p in verts]
-        meshes.append((shape.get("id") or "shape%d" % n, path, world, tris))
+        meshes.append((shape.get("id") or "shape%d" % n, path, world, tris, M))
     return meshes
 
 
@@ -122,9 +179,10 @@ def overlap_area(t, u):
 
 def planes(meshes, tol):
     """Triangles grouped by their plane: normal up to sign (to 1e-3), then runs of offsets that
-    are each within tol of the one before."""
+    are each within tol of the one before. A lint, not a proof: two normals on either side of a
+    1e-3 rounding boundary land in different groups, and such a pair is missed."""
     by_normal = {}
-    for m, (_, _, world, tris) in enumerate(meshes):
+    for m, (_, _, world, tris, _) in enumerate(meshes):
         for k, ((i, j, l), line) in enumerate(tris):
             a, b, c = world[i], world[j], world[l]
             n = cross(sub(b, a), sub(c, a))
@@ -132,7 +190,7 @@ def planes(meshes, tol):
             if length < 1e-12:
                 continue
             n = tuple(x / length for x in n)
-            s = 1.0 if max(n, key=abs) > 0 else -1.0
+            s = 1.0 if next(x for x in n if abs(x) > 1e-4) > 0 else -1.0  # stable at 45 degrees
             key = tuple(round(s * x / 1e-3) for x in n)
             by_normal.setdefault(key, []).append((s * dot(n, a), (m, k, line, n, (a, b, c))))
     groups = []
@@ -193,50 +251,79 @@ def report(meshes, found, every=False):
     return lines
 
 
-def push(xml_path, meshes, spec, distance, out):
-    """Writes the scene folder to out with spec's faces moved back by distance along their normal."""
+def parse_push(spec, meshes, xml_path):
+    """The mesh and the OBJ f-line numbers that --push SHAPE:LINE,LINE names; each must exist."""
     shape_id, _, numbers = spec.partition(":")
-    wanted = {int(x) for x in numbers.split(",") if x}
+    try:
+        wanted = {int(x) for x in numbers.split(",") if x}
+    except ValueError:
+        fail("--push %s: expected SHAPE_ID:LINE,LINE (OBJ f-line numbers)" % spec)
     mesh = next((m for m in meshes if m[0] == shape_id), None)
     if mesh is None or not wanted:
         fail("--push %s: expected SHAPE_ID:LINE,LINE with an obj shape of %s" % (spec, xml_path))
-    _, path, _, tris = mesh
+    missing = sorted(wanted - {line for _, line in mesh[3]})
+    if missing:
+        fail("--push %s: %s has no face on line(s) %s" % (spec, mesh[1], missing[:8]))
+    if any(abs(mesh[4][r][c] - (r == c)) > 1e-12 for r in range(4) for c in range(4)):
+        fail("--push %s: shape '%s' has a to_world; only untransformed shapes can be pushed (the "
+             "distance and the side are the OBJ's own)" % (spec, shape_id))
+    return mesh, wanted
+
+
+def copy_target(xml_path, obj_path, out):
+    """(scene folder, where the rewritten OBJ goes): refuses an --out that is or lies inside the
+    scene folder, and an OBJ outside it, so the original files are never written."""
+    src = os.path.realpath(os.path.dirname(os.path.abspath(xml_path)))
+    dst = os.path.realpath(out)
+    obj = os.path.realpath(obj_path)
+    if dst == src or dst.startswith(src + os.sep):
+        fail("--out %s: must not be the scene's folder or inside it" % out)
+    if not obj.startswith(src + os.sep):
+        fail("--push: %s lies outside the scene's folder %s; copy the scene first" % (obj_path, src))
+    return src, os.path.join(dst, os.path.relpath(obj, src))
+
+
+def link_tree(src, dst, skip):
+    """dst mirrors src: folders made, files and linked folders linked, skip (a real path) left out."""
+    for folder, dirs, files in os.walk(src):
+        target = os.path.join(dst, os.path.relpath(folder, src))
+        os.makedirs(target, exist_ok=True)
+        linked = [d for d in dirs if os.path.islink(os.path.join(folder, d))]
+        for name in files + linked:
+            here, link = os.path.join(folder, name), os.path.join(target, name)
+            if os.path.realpath(here) != skip and not os.path.lexists(link):
+                os.symlink(here, link)
+
+
+def push(xml_path, meshes, spec, distance, out):
+    """Writes the scene folder to out with spec's faces moved back by distance along their normal."""
+    (_, path, verts, tris, _), wanted = parse_push(spec, meshes, xml_path)
     moved = {i for tri, line in tris if line in wanted for i in tri}
     shared = sorted(line for tri, line in tris if line not in wanted and moved & set(tri))
     if shared:
         fail("--push %s: its vertices are also used by f-lines %s of %s" % (spec, shared[:8], path))
-    verts, _ = read_obj(path)
     normals = []
     for tri, line in tris:
         if line in wanted:
             n = cross(sub(verts[tri[1]], verts[tri[0]]), sub(verts[tri[2]], verts[tri[0]]))
-            normals.append(tuple(x / math.sqrt(dot(n, n)) for x in n))
-    if not normals or any(dot(n, normals[0]) < 1 - 1e-6 for n in normals):
-        fail("--push %s: the faces must exist and share one normal (one side of one plane)" % spec)
-    normal = normals[0]
-    src = os.path.dirname(os.path.abspath(xml_path))
-    for folder, _, files in os.walk(src):
-        target = os.path.join(out, os.path.relpath(folder, src))
-        os.makedirs(target, exist_ok=True)
-        for f in files:
-            link = os.path.join(target, f)
-            if os.path.abspath(os.path.join(folder, f)) != os.path.abspath(path) and not os.path.lexists(link):
-                os.symlink(os.path.join(folder, f), link)
+            normals.append(tuple(x / max(math.sqrt(dot(n, n)), 1e-30) for x in n))
+    if any(dot(n, normals[0]) < 1 - 1e-6 for n in normals):
+        fail("--push %s: the faces must share one normal (one side of one plane)" % spec)
+    src, target = copy_target(xml_path, path, out)
+    link_tree(src, os.path.realpath(out), os.path.realpath(path))
     rewritten, vertex = [], -1
     with open(path) as f:
         for line in f:
-            if line.startswith("v "):
+            parts = line.split()
+            if parts and parts[0] == "v":
                 vertex += 1
                 if vertex in moved:
-                    p = [float(x) for x in line.split()[1:4]]
-                    line = "v %.6f %.6f %.6f\n" % tuple(p[c] - distance * normal[c] for c in range(3))
+                    p = [float(x) - distance * normals[0][c] for c, x in enumerate(parts[1:4])]
+                    line = " ".join(["v"] + ["%.9g" % x for x in p] + parts[4:]) + "\n"
             rewritten.append(line)
-    target = os.path.join(out, os.path.relpath(os.path.abspath(path), src))
-    if os.path.lexists(target):
-        os.remove(target)
     with open(target + ".tmp", "w") as f:
         f.writelines(rewritten)
-    os.replace(target + ".tmp", target)
+    os.replace(target + ".tmp", target)  # replaces a link left by an earlier copy, never its file
     return os.path.join(out, os.path.basename(xml_path)), len(moved)
 
 

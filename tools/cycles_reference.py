@@ -26,7 +26,7 @@ usage:
                     emission counts only where a BSDF-sampled ray hits it (latentpt render
                     --strategy bsdf). Both estimate the same image, so a difference
                     between them is a bias in one of Cycles' two estimators.
-  --no-roulette     no Russian roulette in Cycles (min_light_bounces = the bounce limit): every
+  --no-roulette     no Russian roulette in Cycles (min_light_bounces above the bounce limit): every
                     path runs to max_depth. Slow; for checking Cycles' roulette, which loses
                     energy on long paths (docs/validation.md, "A furnace").
   --help            this text

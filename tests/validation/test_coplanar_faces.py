@@ -60,9 +60,19 @@ class CoplanarFaces(unittest.TestCase):
         self.assertAlmostEqual(areas[(False, "a", "e")], 1.0, places=9, msg="to_world moves e onto a, facing down")
         self.assertAlmostEqual(areas[(False, "b", "e")], 0.5, places=9)
 
+    def test_translate_and_scale_compose_like_a_matrix(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            meshes = C.scene_meshes(write_scene(tmp, '<transform name="to_world"><scale value="2"/><translate z="-10"/></transform>'))
+            areas = shared_area(meshes, C.overlaps(meshes))
+        self.assertAlmostEqual(areas[(False, "a", "e")], 1.0, places=9, msg="scale 2 then translate: e covers a")
+
     def test_push_resolves_the_overlap(self):
         with tempfile.TemporaryDirectory() as tmp:
-            scene = write_scene(tmp)
+            folder = os.path.join(tmp, "scene")
+            os.makedirs(folder)
+            scene = write_scene(folder)
+            with open(os.path.join(folder, "b.obj")) as f:
+                original = f.read()
             out = os.path.join(tmp, "pushed")
             r = subprocess.run([sys.executable, TOOL, scene, "--push", "b:5,6", "--distance", "0.01", "--out", out],
                                capture_output=True, text=True)
@@ -73,6 +83,21 @@ class CoplanarFaces(unittest.TestCase):
             self.assertTrue(all(abs(p[2] + 0.01) < 1e-9 for p in b[2]), "b moved back, along -z")
             areas = shared_area(meshes, C.overlaps(meshes))
             self.assertEqual(set(areas), {(False, "a", "e")})
+            with open(os.path.join(folder, "b.obj")) as f:
+                self.assertEqual(f.read(), original, "the scene's own OBJ is never written")
+
+    def test_push_refuses_what_would_write_into_the_scene(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            scene = write_scene(tmp)
+            for out, why in ((tmp, "must not be the scene's folder"), (os.path.join(tmp, "sub"), "or inside it")):
+                r = subprocess.run([sys.executable, TOOL, scene, "--push", "b:5,6", "--out", out],
+                                   capture_output=True, text=True)
+                self.assertEqual(r.returncode, 2)
+                self.assertIn(why, r.stderr)
+            r = subprocess.run([sys.executable, TOOL, scene, "--push", "b:5,9", "--out", os.path.join(tmp, "o")],
+                               capture_output=True, text=True)
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("no face on line(s) [9]", r.stderr)
 
     def test_push_refuses_faces_sharing_vertices_with_others(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -81,13 +106,30 @@ class CoplanarFaces(unittest.TestCase):
             self.assertEqual(r.returncode, 2)
             self.assertIn("also used by f-lines [6]", r.stderr)
 
-    def test_unsupported_transform_is_one_clear_error(self):
+    def test_a_transform_it_cannot_read_skips_that_shape_and_says_so(self):
         with tempfile.TemporaryDirectory() as tmp:
-            scene = write_scene(tmp, '<transform name="to_world"><translate z="-5"/></transform>')
+            scene = write_scene(tmp, '<transform name="to_world"><rotate x="1" angle="180"/></transform>')
+            r = subprocess.run([sys.executable, TOOL, scene], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("shape 'e' skipped", r.stderr)
+            self.assertIn("4 obj shapes", r.stdout)
+
+    def test_bad_obj_is_one_clear_error(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            scene = write_scene(tmp)
+            for text, field in (("v 0 0 x\n", "field v"), ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "outside 1..3"),
+                                ("v 0 0 0\nf 0 1 1\n", "outside 1..1"), ("v 0 0 0\nf 1 1\n", "at least 3")):
+                with open(os.path.join(tmp, "c.obj"), "w") as f:
+                    f.write(text)
+                r = subprocess.run([sys.executable, TOOL, scene], capture_output=True, text=True)
+                self.assertEqual(r.returncode, 2, text)
+                self.assertIn("c.obj:", r.stderr)
+                self.assertIn(field, r.stderr)
+                self.assertNotIn("Traceback", r.stderr)
+            os.remove(os.path.join(tmp, "c.obj"))
             r = subprocess.run([sys.executable, TOOL, scene], capture_output=True, text=True)
             self.assertEqual(r.returncode, 2)
-            self.assertIn("shape 'e': field to_world", r.stderr)
-            self.assertIn("scene.xml", r.stderr)
+            self.assertIn("c.obj", r.stderr)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ BIN = os.environ.get("LATENTPT_BIN")  # ctest sets it to the built latentpt
 SCENE = """<scene version="3.0.0">
   <sensor type="perspective"><film type="hdrfilm"><rfilter type="tent"><float name="radius" value="2"/></rfilter></film></sensor>
   <!-- <bsdf type="roughconductor" id="old"/> <shape type="obj" id="old"><string name="filename" value="x.obj"/></shape> -->
+  <!-- <bsdf type="conductor" id="old_mirror"/> -->
   <bsdf type="twosided" id="a"><bsdf type="roughplastic"><float name="alpha" value="0.1"/></bsdf></bsdf>
   <bsdf type="plastic" id="b"/>
   <bsdf type="roughconductor" id="c" ><float name="alpha" value="0.2"/></bsdf>
@@ -70,8 +71,9 @@ class Rewrites(unittest.TestCase):
         self.assertIn('<bsdf id="g" type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf>', text)
         self.assertIn('<bsdf type="twosided" id="h"><bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf></bsdf>',
                       text, "a nested conductor ends at its own </bsdf>")
-        self.assertNotIn('type="conductor"', text)
+        self.assertEqual(text.count('type="conductor"'), 1, "only the commented-out one is left")
         self.assertEqual(text.count('type="roughconductor"'), 2, "rough conductors and the comment stay")
+        self.assertIn('<!-- <bsdf type="conductor" id="old_mirror"/> -->', text, "a commented-out mirror stays")
         self.assertNotIn("specular_reflectance", text)
 
     def test_paper_scenes_load_rewritten(self):
@@ -92,7 +94,7 @@ class Rewrites(unittest.TestCase):
                 self.assertTrue(os.path.exists(out))
             path, changed = V.scene_variant(os.path.join(shared, "scenes", "cbox", "cbox_specular.xml"),
                                             os.path.join(tmp, "cbox"), "mirrors", diffuse_mirrors=True)
-            self.assertEqual(changed["bsdfs"], 1, "cbox-specular has one mirror (and one commented out)")
+            self.assertEqual(changed["mirrors"], 1, "cbox-specular has one mirror (and one commented out)")
             out = os.path.join(tmp, "cbox.exr")
             r = subprocess.run([BIN, "render", path, "--res", "16x12", "--spp", "1", "-q", "--out", out],
                                capture_output=True, text=True)
