@@ -329,7 +329,7 @@ def push(xml_path, meshes, spec, distance, out):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("scene", help="Mitsuba 3 XML; its obj shapes are read with their to_world matrices")
+    ap.add_argument("scene", help="Mitsuba 3 XML; its obj shapes are read with their to_world (matrix, translate, scale)")
     ap.add_argument("--tol", type=float, default=1e-5, help="plane offsets closer than this count as one plane")
     ap.add_argument("--push", metavar="SHAPE:LINES", help="faces (OBJ f-line numbers) to move back, e.g. Walls_0005:2004,2005")
     ap.add_argument("--every", action="store_true", help="one line per pair of triangles")
