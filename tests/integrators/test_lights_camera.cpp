@@ -10,6 +10,28 @@
 
 using namespace lpt;
 
+namespace {
+struct MeanSe {
+    double mean, se;
+};
+/// Mean and standard error of f(ls) over n samples of `light` seen from ref, drawn with
+/// sample_1d(seed, i, 0, 0..2).
+template <typename F>
+MeanSe light_sample_mean(const Shape& light, const Vec3f& ref, uint64_t seed, int n, F&& f) {
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < n; ++i) {
+        const uint32_t k = uint32_t(i);
+        const LightSample ls = sample_area_light(
+            light, ref, Eigen::Vector3f(sample_1d(seed, k, 0, 0), sample_1d(seed, k, 0, 1), sample_1d(seed, k, 0, 2)));
+        const double v = f(ls);
+        sum += v;
+        sum2 += v * v;
+    }
+    const double mean = sum / n;
+    return {mean, std::sqrt((sum2 / n - mean * mean) / n)};
+}
+}  // namespace
+
 TEST(AreaLight, SamplePdfMatchesPdfAreaLight) {
     Scene scene = test::form_factor_scene(0.5f, 1.f, 0.5f, 0.3f, 1.f);
     const Shape& light = scene.shapes[scene.find_shape("light")];
@@ -28,18 +50,10 @@ TEST(AreaLight, InversePdfIntegratesSolidAngle) {
     const float a = 0.5f, b = 0.3f, h = 1.f;
     Scene scene = test::form_factor_scene(0.5f, 1.f, a, b, h);
     const Shape& light = scene.shapes[scene.find_shape("light")];
-    double sum = 0, sum2 = 0;
-    const int n = 200000;
-    for (int i = 0; i < n; ++i) {
-        LightSample ls = sample_area_light(
-            light, Vec3f::Zero(), Eigen::Vector3f(sample_1d(2, i, 0, 0), sample_1d(2, i, 0, 1), sample_1d(2, i, 0, 2)));
-        double v = ls.valid() ? 1.0 / ls.pdf : 0.0;
-        sum += v;
-        sum2 += v * v;
-    }
-    double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+    const MeanSe s = light_sample_mean(light, Vec3f::Zero(), 2, 200000,
+                                       [](const LightSample& ls) { return ls.valid() ? 1.0 / ls.pdf : 0.0; });
     double expected = 4 * std::atan(a * b / (h * std::sqrt(a * a + b * b + h * h)));
-    EXPECT_NEAR(mean, expected, 4 * se + 1e-6);
+    EXPECT_NEAR(s.mean, expected, 4 * s.se + 1e-6);
 }
 
 TEST(AreaLight, SphereIrradianceMatchesClosedForm) {
@@ -60,19 +74,12 @@ TEST(AreaLight, SphereIrradianceMatchesClosedForm) {
         const Vec3f to_centre = centre;  // the receiver sits at the origin
         const double d = to_centre.norm(), cos_theta = normal.dot(to_centre) / d;
         ASSERT_GT(normal.dot(to_centre), r) << "the sphere must be entirely above the horizon";
-        double sum = 0, sum2 = 0;
-        const int n = 2000000;  // se ~0.12 %: the far half of the samples adds 0
-        for (int i = 0; i < n; ++i) {
-            LightSample ls =
-                sample_area_light(ball, Vec3f::Zero(),
-                                  Eigen::Vector3f(sample_1d(3, i, 0, 0), sample_1d(3, i, 0, 1), sample_1d(3, i, 0, 2)));
-            const double v = ls.valid() ? std::max(0.f, normal.dot(ls.wi)) / ls.pdf : 0.0;
-            sum += v;
-            sum2 += v * v;
-        }
-        const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+        // 2M samples, se ~0.12 %: the far half of them adds 0
+        const MeanSe s = light_sample_mean(ball, Vec3f::Zero(), 3, 2000000, [&](const LightSample& ls) {
+            return ls.valid() ? std::max(0.f, normal.dot(ls.wi)) / ls.pdf : 0.0;
+        });
         const double expected = M_PI * r * r * cos_theta / (d * d);
-        EXPECT_NEAR(mean, expected, 4 * se + 2e-3 * expected) << "receiver normal " << normal.transpose();
+        EXPECT_NEAR(s.mean, expected, 4 * s.se + 2e-3 * expected) << "receiver normal " << normal.transpose();
     }
 }
 
