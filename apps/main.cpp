@@ -86,6 +86,10 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
     sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.99));
+    sc->add_option("--" + pre + "noise-views", ra.noise_views,
+                   "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone")
+        ->capture_default_str()
+        ->check(positive());
     sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")
         ->capture_default_str()
         ->check(non_negative());

@@ -1,6 +1,8 @@
 #include "pipeline/refine.h"
+#include "autodiff/fit.h"
 #include "autodiff/loss.h"
 #include "core/image_io.h"
+#include "core/sampler.h"
 #include "latent/latent.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/output_lock.h"
@@ -88,6 +90,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
             {"seconds", seconds},
             {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
             {"crop", job.train.crop},
+            {"noise_views", job.noise_views},
             {"lpips_crop", job.train.lpips_crop}};
 }
 
@@ -108,6 +111,35 @@ nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vec
     m["reference"] = j.path_traced ? "reference_rgb.exr (path-traced RGB)" : "decoded target.exr";
     write_png_display((dir / "decoded_refined.png").string(), Image{iw, ih, 3, dec_refined, {}});
     return m;
+}
+
+/// Seed of the fit's k-th extra render of the training view: hashed, so that it is none of the
+/// small seeds (fit seed + 1, edit seed + frame) that the fit's latent and edited frames use.
+uint64_t noise_view_seed(uint64_t fit_seed, int k) { return mix64(fit_seed ^ mix64(0x6e6f697365ull + uint64_t(k))); }
+
+/// The fit's own view first, then job.noise_views − 1 renders of the same camera with other seeds.
+std::vector<RefinerInput> noise_views(const RefineJob& job, RefinerInput fit_view, const Reporter& report) {
+    std::vector<RefinerInput> views;
+    views.push_back(std::move(fit_view));
+    if (job.noise_views <= 1) return views;
+    const FitFolder fit = load_fit_folder(job.fitdir);
+    const int spp = fit.manifest.value("stage1", nlohmann::json::object()).value("final_spp", 0);
+    if (spp <= 0)
+        throw std::runtime_error((fs::path(job.fitdir) / "fit.json").string() +
+                                 ": field 'stage1.final_spp' missing or not positive (needed for --noise-views)");
+    const uint64_t fit_seed = fit.manifest.value("seed", uint64_t(0));
+    report.say("[refine] rendering " + std::to_string(job.noise_views - 1) + " more views of the training view at " +
+               std::to_string(spp) + " spp");
+    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
+    ro.width = views[0].width;
+    ro.height = views[0].height;
+    ro.spp = spp;
+    for (int k = 1; k < job.noise_views; ++k) {
+        ro.seed = noise_view_seed(fit_seed, k);
+        views.push_back(
+            refiner_view(*fit.scene, render_toned(*fit.model, ro, fit.tone), ro.width, ro.height, spp, ro.seed));
+    }
+    return views;
 }
 
 std::string refine_status(const RefinerRecord& r) {
@@ -153,8 +185,9 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         return !cancelled;
     };
     RefineSummary s;
-    s.result = refiner->train(in, target.data, judges.ref_rgb.empty() ? nullptr : &judges.ref_rgb, judges.vae.get(),
-                              judges.lpips.get(), o, on_iteration);
+    s.result =
+        refiner->train(noise_views(job, in, report), target.data, judges.ref_rgb.empty() ? nullptr : &judges.ref_rgb,
+                       judges.vae.get(), judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");
     char best[96];
     std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,

@@ -13,8 +13,12 @@ struct RefineJob {
     std::string fitdir;
     RefinerConfig net;          ///< expansion, squash, dropout, norm (distance_scale comes from the view)
     RefinerTrainOptions train;  ///< iterations, lr, loss weights, crops, patience, seed, checkpoint_every
-    bool resume = false;        ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
-    std::string lpips_dir;      ///< empty = ../shared/models/lpips
+    /// Renders of the training view the refiner trains on: the fit's latent.exr and noise_views − 1
+    /// more at the fit's final spp with independent samples (seeds no edit frame uses), so that it
+    /// learns the scene, not one render's noise (docs/refiner.md "Noise views").
+    int noise_views = 1;
+    bool resume = false;    ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
+    std::string lpips_dir;  ///< empty = ../shared/models/lpips
 };
 
 struct RefineSummary {

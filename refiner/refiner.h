@@ -88,6 +88,14 @@ public:
                              const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
                              const RefinerTrainOptions& options,
                              const std::function<bool(const RefinerRecord&)>& on_iteration = {});
+    /// The same on several renders of the training view with independent samples (one camera, one
+    /// target, different noise): each iteration's crop comes from one of them, chosen by (seed,
+    /// iteration), so the network cannot learn one render's noise as if it were the scene. One
+    /// view trains exactly as train() above.
+    RefinerTrainResult train(const std::vector<RefinerInput>& noise_views, const std::vector<float>& target,
+                             const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
+                             const RefinerTrainOptions& options,
+                             const std::function<bool(const RefinerRecord&)>& on_iteration = {});
 
     const RefinerConfig& config() const;
     /// Number of learnable weights (for reports).

@@ -138,21 +138,35 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
 
 /// The training view as tensors and what each iteration's loss uses.
 struct TrainingData {
-    torch::Tensor x_all, y_all, rgb_all;  ///< inputs, target latent, target RGB (may be undefined)
+    torch::Tensor x_all;           ///< inputs [views, C + 4, h, w]: renders of the view with independent noise
+    torch::Tensor y_all, rgb_all;  ///< target latent, target RGB (may be undefined)
     const TorchVae* vae = nullptr;
     const Lpips* lpips = nullptr;
     int w = 0, h = 0, crop_w = 0, crop_h = 0, lp = 0;
     bool use_lpips = false, use_ssim = false;
 };
 
-TrainingData training_data(const RefinerInput& input, const RefinerConfig& cfg, const std::vector<float>& target,
-                           const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
-                           const RefinerTrainOptions& o) {
+/// The noise views stacked along the batch dimension; all must be of one size.
+torch::Tensor stacked_inputs(const std::vector<RefinerInput>& views, const RefinerConfig& cfg) {
+    if (views.empty()) throw std::invalid_argument("refiner: no training view");
+    std::vector<torch::Tensor> xs;
+    for (const RefinerInput& v : views) {
+        if (v.width != views[0].width || v.height != views[0].height)
+            throw std::invalid_argument("refiner: noise views must all be " + std::to_string(views[0].width) + "x" +
+                                        std::to_string(views[0].height));
+        xs.push_back(refiner_input_tensor(v, cfg));
+    }
+    return xs.size() == 1 ? xs[0] : torch::cat(xs, 0);
+}
+
+TrainingData training_data(const std::vector<RefinerInput>& views, const RefinerConfig& cfg,
+                           const std::vector<float>& target, const std::vector<float>* target_rgb, const Vae* vae,
+                           const Lpips* lpips, const RefinerTrainOptions& o) {
     TrainingData d;
-    d.w = input.width;
-    d.h = input.height;
+    d.x_all = stacked_inputs(views, cfg);
+    d.w = views[0].width;
+    d.h = views[0].height;
     const int w = d.w, h = d.h, c = cfg.latent_channels;
-    d.x_all = refiner_input_tensor(input, cfg);
     if (int64_t(target.size()) != int64_t(w) * h * c)
         throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" + std::to_string(h) +
                                     "x" + std::to_string(c));
@@ -181,7 +195,8 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
     const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
     torch::manual_seed(key);  // dropout masks
     const int cx = pick(key + 1, d.w - d.crop_w), cy = pick(key + 2, d.h - d.crop_h);
-    torch::Tensor x = d.x_all.narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
+    const int view = pick(key + 5, int(d.x_all.size(0)) - 1);  // 0 without drawing when there is one view
+    torch::Tensor x = d.x_all.narrow(0, view, 1).narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
     torch::Tensor y = d.y_all.narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
     torch::Tensor out = net->forward(x);
     torch::Tensor mse = torch::mse_loss(out, y);
@@ -228,9 +243,16 @@ RefinerTrainResult Refiner::train(const RefinerInput& input, const std::vector<f
                                   const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
                                   const RefinerTrainOptions& o,
                                   const std::function<bool(const RefinerRecord&)>& on_iteration) {
+    return train(std::vector<RefinerInput>{input}, target, target_rgb, vae, lpips, o, on_iteration);
+}
+
+RefinerTrainResult Refiner::train(const std::vector<RefinerInput>& noise_views, const std::vector<float>& target,
+                                  const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
+                                  const RefinerTrainOptions& o,
+                                  const std::function<bool(const RefinerRecord&)>& on_iteration) {
     RefinerNet& net = m->net;
     const RefinerConfig& cfg = m->config;
-    const TrainingData data = training_data(input, cfg, target, target_rgb, vae, lpips, o);
+    const TrainingData data = training_data(noise_views, cfg, target, target_rgb, vae, lpips, o);
     TrainingState s(net, o);
     if (o.resume) load_checkpoint(o.checkpoint_path, net, cfg, s);
     const double seconds_before = s.result.history.empty() ? 0.0 : s.result.history.back().seconds;

@@ -31,6 +31,7 @@ import experiment_lib as X  # noqa: E402
 # default is now latent MSE alone, so variants that do not set a loss weight get the mix spelled
 # out (with_mix) and still test what they say and what docs/results.md measured.
 MIX = ["--w-ssim", "1", "--w-lpips", "1"]
+MSE = ["--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"]  # the default's loss, spelled out
 
 # name -> (what it tests, `latentpt refine` options, drop the path-traced RGB so that LPIPS
 # compares with the decoded target as in the paper's loss, iterations: None = --iterations);
@@ -58,6 +59,14 @@ VARIANTS = {
                       False, 3000),
     "mse_only_crop64": ("latent MSE alone on 64² crops (4× the pixels per step; InstanceNorm nearer the whole view)",
                         ["--crop", "64", "--w-ssim", "0", "--w-lpips", "0", "--lpips-crop", "0"], False, None),
+    "noise_views_8": ("latent MSE alone on 8 renders of the training view with independent noise (the fit's + 7)",
+                      MSE + ["--noise-views", "8"], False, None),
+    "noise_views_4": ("latent MSE alone on 4 renders of the training view with independent noise", MSE +
+                      ["--noise-views", "4"], False, None),
+    "paper_code": ("the paper code's refiner: latent MSE alone, lr 1e-4, no InstanceNorm", MSE +
+                   ["--lr", "1e-4", "--norm", "none"], False, None),
+    "mse_no_norm": ("latent MSE alone without InstanceNorm", MSE + ["--norm", "none"], False, None),
+    "mse_no_dropout": ("latent MSE alone, dropout 0", MSE + ["--dropout", "0"], False, None),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),
     "lpips8_long": ("ours with 8² latent LPIPS crops (a quarter of the decode) for 3000 iterations", ["--lpips-crop", "8"],
                     False, 3000),

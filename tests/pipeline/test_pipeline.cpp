@@ -1,12 +1,15 @@
 // The pipeline library called without the CLI: a fit that is cancelled mid-way leaves no result
-// files, and resuming it ends bit-identical to an uninterrupted run; an edit sequence renders.
+// files, and resuming it ends bit-identical to an uninterrupted run; an edit sequence renders;
+// the refiner's noise views are rendered from the fit folder.
 #include "core/image_io.h"
 #include "pipeline/edit.h"
 #include "pipeline/edit_session.h"
 #include "pipeline/fit.h"
+#include "pipeline/refine.h"
 #include "test_util.h"
 #include <gtest/gtest.h>
 #include <filesystem>
+#include <fstream>
 
 using namespace lpt;
 namespace fs = std::filesystem;
@@ -99,4 +102,39 @@ TEST(Pipeline, EditSessionFramesEqualTheRenderedFiles) {
         EXPECT_EQ(f.refined, read_image(stem + "_refined.exr").data) << i;
     }
     EXPECT_THROW(session.frame(8, 2, 5), std::invalid_argument);
+}
+
+// Noise views come from the fit folder: more views change what the refiner sees (iteration
+// records differ once another view is drawn), the record says how many, and a fit.json that
+// cannot say the final render's spp is an error naming the field.
+TEST(Pipeline, RefinerNoiseViewsAreRenderedFromTheFit) {
+    const std::string dir = test::temp_dir("pipeline-noise-views");
+    pipeline::run_fit(small_fit(dir + "/fit"));
+    pipeline::RefineJob r;
+    r.fitdir = dir + "/fit";
+    r.net.expansion = 1;
+    r.train.iterations = 12;
+    r.train.patience = 0;
+    const pipeline::RefineSummary one = pipeline::run_refine(r);
+    r.noise_views = 3;
+    const pipeline::RefineSummary three = pipeline::run_refine(r);
+    EXPECT_EQ(three.metrics["refiner"]["noise_views"], 3);
+    ASSERT_EQ(one.result.history.size(), three.result.history.size());
+    int differ = 0;
+    for (size_t i = 0; i < one.result.history.size(); ++i)
+        differ += one.result.history[i].mse != three.result.history[i].mse;
+    EXPECT_GT(differ, 0) << "the extra views were never drawn";
+
+    std::string manifest = read_file(r.fitdir + "/fit.json");
+    const size_t at = manifest.find("\"final_spp\"");
+    ASSERT_NE(at, std::string::npos);
+    manifest.replace(at, 11, "\"final_spx\"");
+    std::ofstream(r.fitdir + "/fit.json") << manifest;
+    try {
+        pipeline::run_refine(r);
+        ADD_FAILURE() << "a fit.json without stage1.final_spp was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("stage1.final_spp"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("fit.json"), std::string::npos) << e.what();
+    }
 }

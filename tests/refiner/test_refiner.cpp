@@ -1,6 +1,6 @@
 // Refiner (stage 2): identity at start, training lowers the loss on a problem it can solve,
 // save/load and checkpoint/resume reproduce outputs exactly, LPIPS through the TAESD3 decoder
-// gives finite gradients, and bad files are clear errors.
+// gives finite gradients, noise views are drawn evenly, and bad files are clear errors.
 #include "autodiff/fit.h"
 #include "core/scene_loader.h"
 #include "integrators/aov.h"
@@ -133,6 +133,41 @@ TEST(Refiner, TrainingLowersTheLossAndKeepsTheBest) {
     EXPECT_LT(after, 0.25 * before) << "before " << before << " after " << after;
     EXPECT_LT(res.history.back().smoothed, res.history.front().loss);
     EXPECT_GT(res.history.front().dssim, 0.0);
+}
+
+// Noise views: one view, or several identical ones, train bit-identically to the single-view
+// call (the view draw must not move the crops or the dropout); views that differ are all drawn,
+// about equally often. The drawn view shows in iteration records: with lr 0 the network stays the
+// identity (its head starts at zero), so a view offset by k from the target has latent MSE k².
+TEST(Refiner, NoiseViewsAreDrawnEvenlyAndOneViewTrainsAsBefore) {
+    Problem p = make_problem(16, 16);
+    RefinerConfig cfg = small();
+    cfg.dropout = 0.1f;  // dropout masks are drawn per iteration too
+    const RefinerTrainOptions o = latent_training(20, 12);
+    auto single = Refiner::create(cfg, 3), twice = Refiner::create(cfg, 3);
+    single->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    twice->train(std::vector<RefinerInput>{p.in, p.in}, p.target, nullptr, nullptr, nullptr, o);
+    EXPECT_EQ(single->refine(p.in), twice->refine(p.in));
+
+    std::vector<RefinerInput> views(3, p.in);
+    for (int k = 0; k < 3; ++k)
+        for (size_t i = 0; i < p.in.latent.size(); ++i) views[size_t(k)].latent[i] = p.target[i] + float(k);
+    RefinerTrainOptions still = latent_training(150, 8);
+    still.lr = 0.f;
+    still.w_ssim = 0.f;
+    auto r = Refiner::create(cfg, 5);
+    const RefinerTrainResult res = r->train(views, p.target, nullptr, nullptr, nullptr, still);
+    int drawn[3] = {0, 0, 0};
+    for (const RefinerRecord& rec : res.history) {
+        const int k = int(std::lround(std::sqrt(rec.mse)));
+        ASSERT_LT(k, 3) << "iteration " << rec.iteration;
+        ASSERT_NEAR(rec.mse, double(k * k), 1e-6) << "iteration " << rec.iteration;
+        ++drawn[k];
+    }
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(drawn[k], 50, 25) << "view " << k;  // binomial sd 5.8
+
+    views[1].width = 8;
+    EXPECT_THROW(r->train(views, p.target, nullptr, nullptr, nullptr, still), std::invalid_argument);
 }
 
 // A non-finite loss (injected: a NaN in the target) refuses the step instead of aborting the run;
