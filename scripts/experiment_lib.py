@@ -8,6 +8,8 @@ import html
 import json
 import os
 import shlex
+import subprocess
+import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -133,6 +135,17 @@ def write_atomic(path, text):
     with open(tmp, "w") as f:
         f.write(text)
     os.replace(tmp, path)
+
+
+def run_logged(cmd, log, who):
+    """Runs `cmd` with its output appended to `log` (after the command line); on failure exits,
+    naming `who` and the log, as the study scripts do."""
+    with open(log, "a") as f:
+        f.write("$ " + " ".join(cmd) + "\n")
+        f.flush()
+        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
+    if r.returncode != 0:
+        sys.exit(f"{who}: command failed (exit {r.returncode}), see {log}: {' '.join(cmd)}")
 
 
 def write_outputs(out, c, summary, failures, timings):

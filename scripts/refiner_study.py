@@ -21,7 +21,6 @@ import argparse
 import json
 import os
 import shutil
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -90,12 +89,7 @@ def iterations_of(a, name):
 
 
 def run(cmd, log):
-    with open(log, "a") as f:
-        f.write("$ " + " ".join(cmd) + "\n")
-        f.flush()
-        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
-    if r.returncode != 0:
-        sys.exit(f"refiner_study: command failed (exit {r.returncode}), see {log}: {' '.join(cmd)}")
+    X.run_logged(cmd, log, "refiner_study")
 
 
 def train_variant(a, name, vdir):

@@ -17,7 +17,6 @@ import argparse
 import json
 import os
 import shutil
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -25,12 +24,7 @@ import experiment_lib as X  # noqa: E402
 
 
 def run(cmd, log):
-    with open(log, "a") as f:
-        f.write("$ " + " ".join(cmd) + "\n")
-        f.flush()
-        r = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
-    if r.returncode != 0:
-        sys.exit(f"seed_spread: command failed (exit {r.returncode}), see {log}")
+    X.run_logged(cmd, log, "seed_spread")
 
 
 def stage1_fit(c, scene, name, seed, out, log):
