@@ -320,6 +320,20 @@ def ref_spp_of(c, scene):
     return c["ref_spp"] or SCENES[scene][2]
 
 
+def frames_arg(c, scene, kind):
+    """`render --edit --frames A:B:S` of the frames the experiment evaluates."""
+    frames = frames_evaluated(c, scene, kind)
+    return f"{frames[0]}:{frames[-1]}:{c.get('frame_step', 1)}"
+
+
+def edit_metrics(binary, threads, fitdir, edits, out, spp, ref_spp, refs, frames, log, who):
+    """Renders `frames` (A:B:S) of an edit sequence with a fit against cached references, logged
+    (run_logged), and returns the rows of its metrics CSV."""
+    run_logged(edit_argv(binary, threads, fitdir, edits, out, spp, ref_spp, refs, frames), log, who)
+    first, last, _ = (int(x) for x in frames.split(":"))
+    return read_metrics(os.path.join(out, f"metrics_{first}-{last}.csv"))
+
+
 def frame_count(c, scene, kind):
     if c["frames"]:
         return c["frames"]
@@ -338,9 +352,11 @@ def chunks(c, scene, kind):
     return [(f[i], f[min(i + k, len(f)) - 1]) for i in range(0, len(f), k)]
 
 
-def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64):
-    """`latentpt fit` arguments of one ablation fit into `out` (iterations: the config's)."""
+def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refiner=None):
+    """`latentpt fit` arguments of one ablation fit into `out` (iterations: the config's;
+    refiner: None = as the fit's FITS entry says, False = stage 1 only)."""
     terms, extra, refine, lr = FITS[name]
+    refine = refine if refiner is None else refiner
     its, res = c["fit_iterations"], image_res_of(c, scene)
     cmd = [c["bin"], "--threads", str(threads), "fit", scene_file(c, scene), "--encode", "--encode-res", f"{res}x{res}",
            "--ref-spp", str(training_ref_spp_of(c, scene)), "--reference-cache", os.path.join(scene, "refs"),

@@ -88,10 +88,6 @@ def iterations_of(a, name):
 
 
 
-def run(cmd, log):
-    X.run_logged(cmd, log, "refiner_study")
-
-
 def train_variant(a, name, vdir):
     """A copy of the stage-1 fit with its refiner retrained by the variant's options (kept as is
     for 'default'). refine.done records what made the folder: a folder made otherwise (another
@@ -118,18 +114,16 @@ def train_variant(a, name, vdir):
         os.replace(tmp, vdir)
     if opts is not None:
         resume = ["--resume"] if os.path.exists(os.path.join(vdir, "refiner_checkpoint.pt")) else []
-        run([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(iterations), "--seed", "0",
-             "-q"] + opts + resume, os.path.join(vdir, "study.log"))
+        X.run_logged([a.bin, "--threads", str(a.threads), "refine", vdir, "--iterations", str(iterations), "--seed",
+                      "0", "-q"] + opts + resume, os.path.join(vdir, "study.log"), "refiner_study")
     X.write_atomic(done, stamp)
 
 
 def evaluate(a, vdir, kind):
     """Mean refined metrics of one edit sequence (the evaluated frames) rendered by the variant."""
-    out = os.path.join(vdir, "edit_" + kind)
-    first, last, step = (int(x) for x in a.frames.split(":"))
-    run(X.edit_argv(a.bin, a.threads, vdir, os.path.join(a.scene_dir, f"edits-{kind}.json"), out, a.spp, a.ref_spp,
-                    os.path.join(a.scene_dir, "refs"), a.frames), os.path.join(vdir, "study.log"))
-    rows = X.read_metrics(os.path.join(out, f"metrics_{first}-{last}.csv"))
+    rows = X.edit_metrics(a.bin, a.threads, vdir, os.path.join(a.scene_dir, f"edits-{kind}.json"),
+                          os.path.join(vdir, "edit_" + kind), a.spp, a.ref_spp, os.path.join(a.scene_dir, "refs"),
+                          a.frames, os.path.join(vdir, "study.log"), "refiner_study")
     edited = [r for r in rows if int(r["frame"]) != 0]
     return {"lpips": X.mean(rows, "refined_rgb_lpips"), "mse_x100": X.mean(rows, "refined_rgb_mse_x100"),
             "edited_lpips": X.mean(edited, "refined_rgb_lpips"), "edited_mse_x100": X.mean(edited, "refined_rgb_mse_x100"),
@@ -178,9 +172,8 @@ def experiment_defaults(a):
             why = f"no experiment config at {path}" if c is None else f"'{scene}' is not an experiment scene"
             sys.exit(f"refiner_study: {why}; give --frames, --iterations, --ref-spp, --spp")
         return
-    frames = X.frames_evaluated(c, scene, a.kinds[0])
     if a.frames is None:
-        a.frames = f"{frames[0]}:{frames[-1]}:{c.get('frame_step', 1)}"
+        a.frames = X.frames_arg(c, scene, a.kinds[0])
     if a.iterations is None:
         a.iterations = c["refiner_iterations"]
     if a.ref_spp is None:

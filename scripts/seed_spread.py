@@ -23,20 +23,13 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import experiment_lib as X  # noqa: E402
 
 
-def run(cmd, log):
-    X.run_logged(cmd, log, "seed_spread")
-
-
 def stage1_fit(c, scene, name, seed, out, log):
     """The experiment's fit `name` with `seed`, stage 1 only; seed 0 reuses the experiment's."""
     if seed == 0:
         return os.path.join(scene, "fit_" + name)
     if not os.path.exists(os.path.join(out, "fit.json")):
-        argv = X.fit_argv(c, scene, name, os.cpu_count(), out)
-        if "--refiner-iterations" in argv:
-            i = argv.index("--refiner-iterations")
-            argv[i:i + 2] = ["--no-refiner"]
-        run(argv + ["--seed", str(seed)] + (["--resume"] if os.path.isdir(os.path.join(out, "checkpoint")) else []), log)
+        argv = X.fit_argv(c, scene, name, os.cpu_count(), out, refiner=False) + ["--seed", str(seed)]
+        X.run_logged(argv + (["--resume"] if os.path.isdir(os.path.join(out, "checkpoint")) else []), log, "seed_spread")
     return out
 
 
@@ -49,11 +42,9 @@ def without_refiner(fitdir, out):
 
 
 def scores(c, scene, fitdir, kind, frames, log):
-    out = os.path.join(fitdir, "edit_" + kind)
-    first, last, _ = (int(x) for x in frames.split(":"))
-    run(X.edit_argv(c["bin"], os.cpu_count(), fitdir, os.path.join(scene, f"edits-{kind}.json"), out, c["spp"],
-                    X.ref_spp_of(c, os.path.basename(scene)), os.path.join(scene, "refs"), frames), log)
-    rows = X.read_metrics(os.path.join(out, f"metrics_{first}-{last}.csv"))
+    rows = X.edit_metrics(c["bin"], os.cpu_count(), fitdir, os.path.join(scene, f"edits-{kind}.json"),
+                          os.path.join(fitdir, "edit_" + kind), c["spp"], X.ref_spp_of(c, scene),
+                          os.path.join(scene, "refs"), frames, log, "seed_spread")
     return X.mean(rows, "rgb_lpips"), X.mean(rows, "rgb_mse_x100")
 
 
@@ -68,8 +59,7 @@ def main():
     with open(os.path.join(os.path.dirname(scene), "experiment-config.json")) as f:
         c = json.load(f)
     name = os.path.basename(scene)
-    frames_list = X.frames_evaluated(c, name, a.kinds.split(",")[0])
-    frames = f"{frames_list[0]}:{frames_list[-1]}:{c.get('frame_step', 1)}"
+    frames = X.frames_arg(c, name, a.kinds.split(",")[0])
     top = os.path.join(scene, "seed_spread")
     os.makedirs(top, exist_ok=True)
     log = os.path.join(top, "seed_spread.log")
