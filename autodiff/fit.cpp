@@ -109,9 +109,16 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
 
         state.smoothed = state.smoothed < 0 ? loss : o.smoothing * state.smoothed + (1.0 - o.smoothing) * loss;
         bool stop = o.patience > 0 && stopper.update(state.smoothed, it);
-        if (stopper.improved() || o.patience == 0) state.best_raw = ps.raw();
-        state.best_loss = stopper.best_loss();
-        state.best_iteration = stopper.best_iteration();
+        if (o.patience == 0) {
+            // Without early stopping the fit keeps its last parameters: record those as the kept ones.
+            state.best_raw = ps.raw();
+            state.best_loss = state.smoothed;
+            state.best_iteration = it;
+        } else {
+            if (stopper.improved()) state.best_raw = ps.raw();
+            state.best_loss = stopper.best_loss();
+            state.best_iteration = stopper.best_iteration();
+        }
         state.bad_updates = stopper.bad_updates();
         state.next_iteration = it + 1;
         state.adam = adam.state();

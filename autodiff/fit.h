@@ -46,6 +46,8 @@ struct FitState {
     int next_iteration = 0;
     AdamState adam;
     double smoothed = -1.0;  ///< < 0 before the first iteration
+    /// The iteration whose parameters the fit returns and its smoothed loss: the best one with
+    /// early stopping, the last one without (patience 0); −1 before the first iteration.
     double best_loss = 1e300;
     int best_iteration = -1, bad_updates = 0;
     std::vector<float> best_raw;  ///< the parameters at best_iteration

@@ -162,16 +162,16 @@ double write_stage1(const FitJob& job, const LatentModel& model, const Target& t
     return final_loss;
 }
 
-std::string stage1_summary(const FitState& state) {
+std::string stage1_summary(const FitState& state, int patience) {
     char buf[160];
-    // With patience 0 nothing tracks a best iteration: the last parameters are kept.
-    if (state.best_iteration >= 0)
+    if (patience > 0)
         std::snprintf(buf, sizeof buf, "[fit] best smoothed loss %.5f at iteration %d; %d refused steps",
                       state.best_loss, state.best_iteration, state.skipped_steps);
     else
         std::snprintf(buf, sizeof buf,
-                      "[fit] early stopping off: the last iteration's parameters are kept; %d refused steps",
-                      state.skipped_steps);
+                      "[fit] early stopping off: the last iteration's parameters are kept (smoothed loss %.5f); "
+                      "%d refused steps",
+                      state.best_loss, state.skipped_steps);
     return buf;
 }
 
@@ -209,7 +209,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
         report.say("resuming at iteration " + std::to_string(summary.state.next_iteration));
     }
     if (!optimise(model, target, o, summary.state, report)) throw Cancelled("fit");
-    report.say(stage1_summary(summary.state));
+    report.say(stage1_summary(summary.state, o.patience));
     save_checkpoint(o.checkpoint_dir, model, summary.state);
     summary.latent_width = target.width;
     summary.latent_height = target.height;

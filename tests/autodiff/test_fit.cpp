@@ -72,6 +72,9 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
                   << ", final " << final_loss << ", noise floor " << floor << ", skipped steps " << st.skipped_steps
                   << "\n";
         EXPECT_EQ(st.skipped_steps, 0);
+        // Without early stopping (patience 0) the kept parameters are the last iteration's.
+        EXPECT_EQ(st.best_iteration, fo.iterations - 1);
+        EXPECT_EQ(st.best_loss, st.smoothed);
         return std::pair{initial, final_loss};
     };
     auto [init_full, final_full] = run(true, 0);
