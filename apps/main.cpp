@@ -63,6 +63,11 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
     sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")
         ->capture_default_str()
         ->check(positive());
+    sc->add_option_function<std::string>(
+          "--" + pre + "lr-decay", [&ra](const std::string& v) { ra.train.cosine_decay = v == "cosine"; },
+          "refiner learning rate over the steps: none (constant) or cosine (one half cosine down to 0)")
+        ->check(CLI::IsMember({"none", "cosine"}))
+        ->default_str(ra.train.cosine_decay ? "cosine" : "none");
     sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")
         ->capture_default_str()
         ->check(non_negative());

@@ -91,6 +91,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
             {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
             {"crop", job.train.crop},
             {"noise_views", job.noise_views},
+            {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
             {"lpips_crop", job.train.lpips_crop}};
 }
 

@@ -38,6 +38,9 @@ struct RefinerInput {
 struct RefinerTrainOptions {
     int iterations = 3000;
     float lr = 5e-4f;
+    /// Off: every step at lr. On: lr falls along one half cosine from lr to 0 over `iterations`
+    /// (SGDR's first period without restarts, as the fit's schedule with period = iterations).
+    bool cosine_decay = false;
     /// loss = w·MSE + w·(1 − SSIM) + w·LPIPS. MSE alone by default: on cbox-specular's edits it
     /// beat our earlier mix (1, 1, 1) in both metrics at the same training time, because without
     /// a decoder in the loop a step costs a quarter (docs/refiner.md, docs/results.md).

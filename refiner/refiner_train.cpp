@@ -226,6 +226,10 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
     return loss;
 }
 
+void set_learning_rate(torch::optim::Adam& adam, float lr) {
+    for (auto& group : adam.param_groups()) static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+}
+
 /// Back-propagates `loss`; returns "" when every weight's gradient is finite, else the first
 /// weight's name whose is not (the caller then skips the optimiser step).
 std::string backward_or_refuse(RefinerNet& net, torch::Tensor& loss) {
@@ -258,6 +262,7 @@ RefinerTrainResult Refiner::train(const std::vector<RefinerInput>& noise_views, 
     const double seconds_before = s.result.history.empty() ? 0.0 : s.result.history.back().seconds;
     const auto t0 = std::chrono::steady_clock::now();
     bool stopped = o.patience > 0 && s.stop.bad_updates() >= o.patience;
+    const CosineWarmRestarts decay(o.lr, std::max(1, o.iterations));  // a function of it: resumes on the curve
     for (int it = s.start; it < o.iterations && !stopped; ++it) {
         net->train();
         s.adam.zero_grad();
@@ -266,6 +271,7 @@ RefinerTrainResult Refiner::train(const std::vector<RefinerInput>& noise_views, 
         r.refused_parameter = std::isfinite(r.loss) ? backward_or_refuse(net, loss) : "loss";
         r.refused = !r.refused_parameter.empty();
         if (!r.refused) {
+            if (o.cosine_decay) set_learning_rate(s.adam, decay.lr_at(it));
             s.adam.step();
             s.smoothed = it == 0 ? r.loss : kSmoothing * s.smoothed + (1 - kSmoothing) * r.loss;
         }

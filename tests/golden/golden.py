@@ -83,9 +83,15 @@ def image_hash(path):
     raise RuntimeError(f"oiiotool printed no SHA-1 for {path}")
 
 
+# Fields added to metrics.json after the stored hashes, dropped when they hold the value that means
+# "as before": an output that gained a record of a default setting still matches its old hash.
+ADDED_DEFAULTS = {"noise_views": 1, "lr_decay": "none"}
+
+
 def scrub(value):
     if isinstance(value, dict):
-        return {k: scrub(v) for k, v in value.items() if k not in VOLATILE_KEYS}
+        return {k: scrub(v) for k, v in value.items()
+                if k not in VOLATILE_KEYS and not (k in ADDED_DEFAULTS and v == ADDED_DEFAULTS[k])}
     if isinstance(value, list):
         return [scrub(v) for v in value]
     return value

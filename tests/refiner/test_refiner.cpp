@@ -1,6 +1,7 @@
 // Refiner (stage 2): identity at start, training lowers the loss on a problem it can solve,
 // save/load and checkpoint/resume reproduce outputs exactly, LPIPS through the TAESD3 decoder
-// gives finite gradients, noise views are drawn evenly, and bad files are clear errors.
+// gives finite gradients, noise views are drawn evenly, cosine decay scales the steps, and bad
+// files are clear errors.
 #include "autodiff/fit.h"
 #include "core/scene_loader.h"
 #include "integrators/aov.h"
@@ -168,6 +169,42 @@ TEST(Refiner, NoiseViewsAreDrawnEvenlyAndOneViewTrainsAsBefore) {
 
     views[1].width = 8;
     EXPECT_THROW(r->train(views, p.target, nullptr, nullptr, nullptr, still), std::invalid_argument);
+}
+
+// Cosine decay: step i uses lr · (1 + cos(π i / N)) / 2. Two runs of N = 2 steps from one start,
+// constant and decayed, take the same first step (lr) and then the same Adam direction from the
+// same weights, the decayed one at half the rate (cos(π/2) = 0), so its second step moves the
+// refined view half as far (to first order in the small lr).
+TEST(Refiner, CosineDecayScalesEachStepByTheSchedule) {
+    Problem p = make_problem(12, 12);
+    RefinerTrainOptions o = latent_training(1, 0);  // whole view: both steps see the same data
+    o.lr = 3e-5f;
+    o.w_ssim = 0.f;
+    o.min_delta = 0.f;  // a small step's smoothed gain (2 % of it) still counts as the best weights
+    auto one = Refiner::create(small(), 4);
+    one->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    const std::vector<float> start = one->refine(p.in);
+    o.iterations = 2;
+    auto steps = [&](bool cosine) {
+        RefinerTrainOptions oc = o;
+        oc.cosine_decay = cosine;
+        auto r = Refiner::create(small(), 4);
+        const RefinerTrainResult res = r->train(p.in, p.target, nullptr, nullptr, nullptr, oc);
+        // The second step lowered the loss, so the kept (best smoothed) weights are the last ones.
+        EXPECT_LT(res.history[1].loss, res.history[0].loss);
+        std::vector<float> moved = r->refine(p.in);
+        for (size_t i = 0; i < moved.size(); ++i) moved[i] -= start[i];
+        return moved;
+    };
+    const std::vector<float> constant = steps(false), decayed = steps(true);
+    double dot = 0, norm = 0;
+    for (size_t i = 0; i < constant.size(); ++i) {
+        dot += double(decayed[i]) * constant[i];
+        norm += double(constant[i]) * constant[i];
+    }
+    ASSERT_GT(norm, 0.0);
+    std::cout << "second step, decayed against constant: " << dot / norm << " (schedule: 0.5)\n";
+    EXPECT_NEAR(dot / norm, 0.5, 0.02);
 }
 
 // A non-finite loss (injected: a NaN in the target) refuses the step instead of aborting the run;
