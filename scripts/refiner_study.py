@@ -68,6 +68,8 @@ VARIANTS = {
     "mse_no_dropout": ("latent MSE alone, dropout 0", MSE + ["--dropout", "0"], False, None),
     "mse_cosine": ("latent MSE alone, lr falling along a half cosine to 0", MSE + ["--lr-decay", "cosine"], False, None),
     "mse_9000": ("latent MSE alone for 9000 iterations (the training loss still falls at 3000)", MSE, False, 9000),
+    "mse_6000_cosine": ("latent MSE alone for 6000 iterations, lr falling along a half cosine to 0",
+                        MSE + ["--lr-decay", "cosine"], False, 6000),
     "mse_9000_cosine": ("latent MSE alone for 9000 iterations, lr falling along a half cosine to 0",
                         MSE + ["--lr-decay", "cosine"], False, 9000),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),
