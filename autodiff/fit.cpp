@@ -52,6 +52,21 @@ std::string first_bad_gradient(const ParamStore& ps) {
     return "?";
 }
 
+/// What the fit will return: the best parameters so far with early stopping, the last ones
+/// without (patience 0), with their iteration and smoothed loss.
+void record_kept_parameters(FitState& state, const EarlyStopping& stopper, int patience, const std::vector<float>& raw,
+                            int it) {
+    if (patience == 0) {
+        state.best_raw = raw;
+        state.best_loss = state.smoothed;
+        state.best_iteration = it;
+        return;
+    }
+    if (stopper.improved()) state.best_raw = raw;
+    state.best_loss = stopper.best_loss();
+    state.best_iteration = stopper.best_iteration();
+}
+
 }  // namespace
 
 FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o,
@@ -109,16 +124,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
 
         state.smoothed = state.smoothed < 0 ? loss : o.smoothing * state.smoothed + (1.0 - o.smoothing) * loss;
         bool stop = o.patience > 0 && stopper.update(state.smoothed, it);
-        if (o.patience == 0) {
-            // Without early stopping the fit keeps its last parameters: record those as the kept ones.
-            state.best_raw = ps.raw();
-            state.best_loss = state.smoothed;
-            state.best_iteration = it;
-        } else {
-            if (stopper.improved()) state.best_raw = ps.raw();
-            state.best_loss = stopper.best_loss();
-            state.best_iteration = stopper.best_iteration();
-        }
+        record_kept_parameters(state, stopper, o.patience, ps.raw(), it);
         state.bad_updates = stopper.bad_updates();
         state.next_iteration = it + 1;
         state.adam = adam.state();
