@@ -1,5 +1,4 @@
 #include "pipeline/edit_session.h"
-#include "autodiff/fit.h"
 #include "pipeline/refiner_io.h"
 #include <filesystem>
 #include <stdexcept>
@@ -12,18 +11,13 @@ namespace {
 
 /// The already edited scene of `fit` at spp with seed, refined when `refiner` is given.
 FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int width, int height, int spp, uint64_t seed) {
-    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
-    ro.width = width;
-    ro.height = height;
-    ro.spp = spp;
-    ro.seed = seed;
     FrameLatents f;
     f.width = width;
     f.height = height;
-    f.latent = render_toned(*fit.model, ro, fit.tone);
+    f.latent = render_fit_latent(fit, width, height, spp, seed);
     if (refiner) {
         // Same spp and seed as the latent: an identity edit reproduces the fit's refined latent.
-        f.view = refiner_view(*fit.scene, f.latent, width, height, ro.spp, ro.seed);
+        f.view = refiner_view(*fit.scene, f.latent, width, height, spp, seed);
         f.refined = refiner->refine(f.view);
     }
     return f;

@@ -1,4 +1,5 @@
 #include "pipeline/fit_folder.h"
+#include "autodiff/fit.h"
 #include "core/json_number.h"
 #include "core/scene_loader.h"
 #include "pipeline/fit.h"
@@ -20,6 +21,15 @@ nlohmann::json parse_json_file(const std::string& path) {
 }
 
 }  // namespace
+
+std::vector<float> render_fit_latent(const FitFolder& fit, int w, int h, int spp, uint64_t seed) {
+    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
+    ro.width = w;
+    ro.height = h;
+    ro.spp = spp;
+    ro.seed = seed;
+    return render_toned(*fit.model, ro, fit.tone);
+}
 
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {
     LatentTerms<kLatentChannels>& t = model.terms();

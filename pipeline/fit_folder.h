@@ -36,6 +36,10 @@ struct FitFolder {
 /// `defines` override the fit's own -D values.
 FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, std::string>& defines = {});
 
+/// The fitted model's tone-mapped latent of its (possibly edited) scene at w × h, spp and seed:
+/// what edited frames and the refiner's extra training renders are made of.
+std::vector<float> render_fit_latent(const FitFolder& fit, int w, int h, int spp, uint64_t seed);
+
 /// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac").
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
 

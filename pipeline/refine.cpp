@@ -1,5 +1,4 @@
 #include "pipeline/refine.h"
-#include "autodiff/fit.h"
 #include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "core/sampler.h"
@@ -131,14 +130,10 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, RefinerInput fit_vie
     const uint64_t fit_seed = fit.manifest.value("seed", uint64_t(0));
     report.say("[refine] rendering " + std::to_string(job.noise_views - 1) + " more views of the training view at " +
                std::to_string(spp) + " spp");
-    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
-    ro.width = views[0].width;
-    ro.height = views[0].height;
-    ro.spp = spp;
+    const int w = views[0].width, h = views[0].height;
     for (int k = 1; k < job.noise_views; ++k) {
-        ro.seed = noise_view_seed(fit_seed, k);
-        views.push_back(
-            refiner_view(*fit.scene, render_toned(*fit.model, ro, fit.tone), ro.width, ro.height, spp, ro.seed));
+        const uint64_t seed = noise_view_seed(fit_seed, k);
+        views.push_back(refiner_view(*fit.scene, render_fit_latent(fit, w, h, spp, seed), w, h, spp, seed));
     }
     return views;
 }
