@@ -267,8 +267,8 @@ def write_outputs(out, c, summary, failures, timings):
 PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
          "scene_res": {"cbox-specular": 1024, "veach-bidir": 512, "dining-room": 512},
          "frame_step": 15, "ref_spp": 512, "training_ref_spp": 512, "fit_iterations": 3000,
-         "refiner_iterations": 6000, "refiner_lr_decay": "cosine", "fits": ["e", "ea", "eac"], "spp_list": [1, 4, 16, 64, 256],
-         "conv_views": ["training"], "equal_error_max_spp": 64}
+         "refiner_iterations": 6000, "refiner_lr_decay": "cosine", "fits": ["e", "ea", "eac"],
+         "spp_list": [1, 4, 16, 64, 256], "conv_views": ["training"], "equal_error_max_spp": 64}
 
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
