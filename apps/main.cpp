@@ -88,6 +88,12 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
           "normalisation after each convolution: instance (ours) or none (the paper's network)")
         ->check(CLI::IsMember({"instance", "none"}))
         ->default_str(ra.net.instance_norm ? "instance" : "none");
+    sc->add_option_function<std::string>(
+          "--" + pre + "inference", [&ra](const std::string& v) { ra.windowed_inference = v == "windows"; },
+          "how the trained refiner is applied: windows (the training crop's size, stride half of it, averaged; "
+          "InstanceNorm then sees what it saw in training) or whole (the whole view at once)")
+        ->check(CLI::IsMember({"windows", "whole"}))
+        ->default_str(ra.windowed_inference ? "windows" : "whole");
     sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.99));

@@ -91,6 +91,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
             {"crop", job.train.crop},
             {"noise_views", job.noise_views},
             {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
+            {"inference_window", refiner.config().tile},
             {"lpips_crop", job.train.lpips_crop}};
 }
 
@@ -145,6 +146,15 @@ std::string refine_status(const RefinerRecord& r) {
     return buf;
 }
 
+/// The refiner's inference window: its training crop, when InstanceNorm makes the output depend
+/// on the statistics of what the network sees and the crop is smaller than the view; else 0
+/// (the whole view, which is then also what training saw).
+int inference_window(const RefineJob& job, const RefinerInput& in) {
+    const int crop = job.train.crop;
+    if (!job.windowed_inference || !job.net.instance_norm || crop <= 0) return 0;
+    return crop < in.width || crop < in.height ? crop : 0;
+}
+
 }  // namespace
 
 RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
@@ -159,6 +169,7 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     RefinerConfig cfg = job.net;
     cfg.latent_channels = kLatentChannels;
     cfg.distance_scale = mean_hit_distance(in);
+    cfg.tile = inference_window(job, in);
     auto refiner = Refiner::create(cfg, job.train.seed);
     RefinerTrainOptions o = job.train;
     o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();

@@ -17,6 +17,9 @@ struct RefineJob {
     /// more at the fit's final spp with independent samples (seeds no edit frame uses), so that it
     /// learns the scene, not one render's noise (docs/refiner.md "Noise views").
     int noise_views = 1;
+    /// Apply the trained refiner on windows the size of its training crop (RefinerConfig::tile)
+    /// when InstanceNorm is on and the crop is smaller than the view; false: the whole view at once.
+    bool windowed_inference = true;
     bool resume = false;    ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
     std::string lpips_dir;  ///< empty = ../shared/models/lpips
 };

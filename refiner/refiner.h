@@ -25,6 +25,12 @@ struct RefinerConfig {
     /// then a pixel's output depends only on its 9×9 neighbourhood, not on the statistics of the
     /// crop or view around it (except within 4 pixels of an edge, where padding stands in).
     bool instance_norm = true;
+    /// Inference window (latent pixels per side; 0 = the whole view at once). With InstanceNorm
+    /// the output depends on the statistics of what the network sees, so a refiner trained on
+    /// n×n crops is applied to n×n windows at stride n/2 whose outputs are averaged per pixel
+    /// (docs/refiner.md "Windows"). A view no larger than the window is one window: the whole view.
+    /// Files written before the option hold none and load as 0.
+    int tile = 0;
 };
 
 /// What the refiner reads for one view: the rendered (tone-mapped) latent and its AOVs.

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
+#include <utility>
+#include <vector>
 
 namespace lpt {
 
@@ -15,6 +17,42 @@ torch::nn::Conv2d conv(int64_t in, int64_t out, int64_t k) {
 }
 
 void use_all_cores() { at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency()))); }
+
+/// Origins of windows of `window` pixels along an axis of `size`: every window/2 pixels, and the
+/// last one flush with the far edge, so that every pixel is covered.
+std::vector<int64_t> window_origins(int64_t size, int64_t window) {
+    std::vector<int64_t> origins;
+    const int64_t stride = std::max<int64_t>(1, window / 2);
+    for (int64_t o = 0; o + window < size; o += stride) origins.push_back(o);
+    origins.push_back(std::max<int64_t>(0, size - window));
+    return origins;
+}
+
+/// The network on tile×tile windows of x (fewer pixels along an axis shorter than that), the
+/// outputs averaged where windows overlap. Windows go through in batches to bound memory; the
+/// sums run in a fixed order, so the result is deterministic.
+torch::Tensor forward_in_windows(RefinerNet& net, const torch::Tensor& x, int tile) {
+    constexpr size_t kBatch = 32;
+    const int64_t h = x.size(2), w = x.size(3), th = std::min<int64_t>(tile, h), tw = std::min<int64_t>(tile, w);
+    std::vector<std::pair<int64_t, int64_t>> windows;
+    for (int64_t y : window_origins(h, th))
+        for (int64_t x0 : window_origins(w, tw)) windows.emplace_back(y, x0);
+    torch::Tensor sum = torch::zeros({1, int64_t(net->cfg.latent_channels), h, w});
+    torch::Tensor count = torch::zeros({1, 1, h, w});
+    for (size_t first = 0; first < windows.size(); first += kBatch) {
+        const size_t n = std::min(kBatch, windows.size() - first);
+        std::vector<torch::Tensor> crops;
+        for (size_t i = first; i < first + n; ++i)
+            crops.push_back(x.narrow(2, windows[i].first, th).narrow(3, windows[i].second, tw));
+        const torch::Tensor out = net->forward(torch::cat(crops, 0));
+        for (size_t i = 0; i < n; ++i) {
+            const auto [y, x0] = windows[first + i];
+            sum.narrow(2, y, th).narrow(3, x0, tw).add_(out.narrow(0, int64_t(i), 1));
+            count.narrow(2, y, th).narrow(3, x0, tw).add_(1.0);
+        }
+    }
+    return sum / count;
+}
 
 }  // namespace
 
@@ -96,7 +134,10 @@ int64_t Refiner::parameter_count() const {
 std::vector<float> Refiner::refine(const RefinerInput& input) const {
     torch::NoGradGuard no_grad;
     m->net->eval();
-    return refiner_to_hwc(m->net->forward(refiner_input_tensor(input, m->config)));
+    const torch::Tensor x = refiner_input_tensor(input, m->config);
+    const int tile = m->config.tile;
+    const bool one_window = tile <= 0 || (input.width <= tile && input.height <= tile);
+    return refiner_to_hwc(one_window ? m->net->forward(x) : forward_in_windows(m->net, x, tile));
 }
 
 void Refiner::save(const std::string& path) const {
@@ -109,6 +150,7 @@ void Refiner::save(const std::string& path) const {
     ar.write("config.dropout", c10::IValue(double(c.dropout)));
     ar.write("config.distance_scale", c10::IValue(double(c.distance_scale)));
     ar.write("config.instance_norm", c10::IValue(int64_t(c.instance_norm)));
+    ar.write("config.tile", c10::IValue(int64_t(c.tile)));
     const std::string tmp = path + ".tmp";
     ar.save_to(tmp);
     std::filesystem::rename(tmp, path);
@@ -133,6 +175,8 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c.dropout = float(get("config.dropout").toDouble());
         c.distance_scale = float(get("config.distance_scale").toDouble());
         c.instance_norm = archived_instance_norm(ar);
+        c10::IValue tile;
+        c.tile = ar.try_read("config.tile", tile) ? int(tile.toInt()) : 0;  // older files: the whole view
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
         impl->net->load(ar);
         return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));

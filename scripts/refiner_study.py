@@ -70,6 +70,12 @@ VARIANTS = {
     "mse_9000": ("latent MSE alone for 9000 iterations (the training loss still falls at 3000)", MSE, False, 9000),
     "mse_6000_cosine": ("latent MSE alone for 6000 iterations, lr falling along a half cosine to 0",
                         MSE + ["--lr-decay", "cosine"], False, 6000),
+    # Made before windowed inference (2026-11-26), mse_6000_cosine folders applied the refiner to
+    # the whole view; the two below name the inference, so their folders mean one thing.
+    "mse_6000_cosine_whole": ("mse_6000_cosine applied to the whole view at once (before 2026-11-26: every variant)",
+                              MSE + ["--lr-decay", "cosine", "--inference", "whole"], False, 6000),
+    "mse_6000_cosine_windows": ("mse_6000_cosine applied on windows of its 32² training crop, stride 16, averaged",
+                                MSE + ["--lr-decay", "cosine", "--inference", "windows"], False, 6000),
     "mse_9000_cosine": ("latent MSE alone for 9000 iterations, lr falling along a half cosine to 0",
                         MSE + ["--lr-decay", "cosine"], False, 9000),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),

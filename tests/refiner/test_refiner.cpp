@@ -1,7 +1,7 @@
 // Refiner (stage 2): identity at start, training lowers the loss on a problem it can solve,
 // save/load and checkpoint/resume reproduce outputs exactly, LPIPS through the TAESD3 decoder
-// gives finite gradients, noise views are drawn evenly, cosine decay scales the steps, and bad
-// files are clear errors.
+// gives finite gradients, noise views are drawn evenly, cosine decay scales the steps, windowed
+// inference averages the windows it says, and bad files are clear errors.
 #include "autodiff/fit.h"
 #include "core/scene_loader.h"
 #include "integrators/aov.h"
@@ -318,6 +318,50 @@ TEST(Refiner, WithoutInstanceNormACropIsRefinedAsTheWholeView) {
     } catch (const std::runtime_error& e) {
         EXPECT_NE(std::string(e.what()).find("--norm instance"), std::string::npos) << e.what();
     }
+}
+
+// Windowed inference (RefinerConfig::tile, docs/refiner.md "Windows"): the refined view is, per
+// pixel, the mean of the refiner applied to every tile×tile window at stride tile/2, the last
+// window flush with the far edge; checked against those windows refined one by one, at origins
+// written out by hand. The window changes inference only: the same training with tile 0 refines
+// each window identically, and its whole-view output differs (InstanceNorm statistics).
+TEST(Refiner, WindowsAverageTheRefinedWindowsOfTheTrainingCropSize) {
+    Problem p = make_problem(21, 13);
+    RefinerConfig cfg = small();
+    cfg.tile = 8;
+    auto windowed = Refiner::create(cfg, 5), whole = Refiner::create(small(), 5);
+    windowed->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
+    whole->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
+    const std::vector<float> out = windowed->refine(p.in);
+
+    const std::vector<int> xs = {0, 4, 8, 12, 13}, ys = {0, 4, 5};  // 21 and 13 pixels, windows of 8
+    std::vector<double> sum(out.size(), 0.0), count(out.size(), 0.0);
+    for (int y0 : ys)
+        for (int x0 : xs) {
+            const RefinerInput window = crop_of(p.in, x0, y0, 8, 8);
+            const std::vector<float> part = windowed->refine(window);
+            ASSERT_EQ(part, whole->refine(window)) << "the window changed training, not just inference";
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x)
+                    for (int c = 0; c < kC; ++c) {
+                        const size_t i = (size_t(y0 + y) * size_t(p.in.width) + size_t(x0 + x)) * kC + size_t(c);
+                        sum[i] += part[(size_t(y) * 8 + size_t(x)) * kC + size_t(c)];
+                        count[i] += 1.0;
+                    }
+        }
+    double worst = 0;
+    for (size_t i = 0; i < out.size(); ++i) {
+        ASSERT_GT(count[i], 0.0) << "pixel " << i / kC << " is in no window";
+        worst = std::max(worst, std::abs(out[i] - sum[i] / count[i]));
+    }
+    EXPECT_LT(worst, 1e-5);
+    EXPECT_GT(mse(out, whole->refine(p.in)), 1e-8) << "windows gave the whole view's output";
+
+    const std::string file = temp_path("windowed_refiner.pt");
+    windowed->save(file);
+    auto loaded = Refiner::load(file);
+    EXPECT_EQ(loaded->config().tile, 8);
+    EXPECT_EQ(loaded->refine(p.in), out);
 }
 
 TEST(Refiner, LpipsThroughTheDecoderTrains) {
