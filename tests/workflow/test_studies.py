@@ -2,7 +2,7 @@
 """scripts/refiner_study.py and scripts/seed_spread.py on a copy of experiment.quick's folder
 (the ctest fixture): each study scores, by its own path, a cell that the experiment scored, and
 must give the experiment's number; what the study itself adds (a retrained refiner, another
-seed) must really differ from what it copied. ~1 min on 2 cores.
+seed) must really differ from what it copied. 60 s in CI (2 cores).
 
     tests/workflow/test_studies.py --bin build/apps/latentpt --experiment build/experiment-quick --out build/studies
 
