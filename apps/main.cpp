@@ -101,6 +101,12 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
                    "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone")
         ->capture_default_str()
         ->check(positive());
+    sc->add_option_function<std::string>(
+          "--" + pre + "augment", [&ra](const std::string& v) { ra.augment = pipeline::parse_refiner_augment(v); },
+          "extra training views made from the training view alone: none, mirror (its mirror image) or dihedral "
+          "(also the camera rolled by quarter turns); each against its reference moved the same way and encoded")
+        ->check(CLI::IsMember({"none", "mirror", "dihedral"}))
+        ->default_str(pipeline::to_string(ra.augment));
     sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")
         ->capture_default_str()
         ->check(non_negative());

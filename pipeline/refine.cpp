@@ -6,6 +6,7 @@
 #include "pipeline/fit_folder.h"
 #include "pipeline/output_lock.h"
 #include "pipeline/paths.h"
+#include "pipeline/refiner_augment.h"
 #include "pipeline/refiner_io.h"
 #include "vae/lpips.h"
 #include "vae/vae.h"
@@ -90,6 +91,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
             {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
             {"crop", job.train.crop},
             {"noise_views", job.noise_views},
+            {"augment", to_string(job.augment)},
             {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
             {"inference_window", refiner.config().tile},
             {"lpips_crop", job.train.lpips_crop}};
@@ -137,6 +139,36 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, RefinerInput fit_vie
         views.push_back(refiner_view(*fit.scene, render_fit_latent(fit, w, h, spp, seed), w, h, spp, seed));
     }
     return views;
+}
+
+/// The camera's x axis in world space, unit length: the normal of the plane a mirrored view
+/// reflects the world across.
+Vec3f camera_right(const Scene& scene) { return scene.camera.world_from_camera.vector(Vec3f::UnitX()).normalized(); }
+
+/// The training examples: every noise view against the target, then (job.augment) every noise
+/// view moved by each other transform, against the reference image moved the same way and
+/// encoded again (docs/refiner.md "Augmentation").
+std::vector<RefinerExample> training_examples(const RefineJob& job, const std::vector<RefinerInput>& views,
+                                              const Image& target, const Judges& judges, const Reporter& report) {
+    std::vector<RefinerExample> examples;
+    for (const RefinerInput& v : views) examples.push_back({v, target.data, judges.ref_rgb});
+    const std::vector<ViewTransform> moves = augment_transforms(job.augment);
+    if (moves.size() == 1) return examples;
+    if (!judges.path_traced || !judges.vae)
+        throw std::runtime_error((fs::path(job.fitdir) / "reference_rgb.exr").string() + ": --refiner-augment " +
+                                 to_string(job.augment) + " needs the fit's path-traced reference and its VAE " +
+                                 (judges.path_traced ? "(no VAE found)" : "(missing: fit with --encode)"));
+    report.say("[refine] " + std::to_string(moves.size() - 1) + " augmented views (" + to_string(job.augment) +
+               "): encoding their references");
+    const Vec3f right = camera_right(*load_fit_folder(job.fitdir).scene);
+    const int iw = 8 * target.width, ih = 8 * target.height;
+    for (size_t m = 1; m < moves.size(); ++m) {
+        std::vector<float> rgb = transform_image(judges.ref_rgb, iw, ih, 3, moves[m]);
+        const bool swap = moves[m].quarter_turns % 2 != 0;
+        std::vector<float> moved_target = judges.vae->encode(rgb, swap ? ih : iw, swap ? iw : ih);
+        for (const RefinerInput& v : views) examples.push_back({transform_view(v, moves[m], right), moved_target, rgb});
+    }
+    return examples;
 }
 
 std::string refine_status(const RefinerRecord& r) {
@@ -192,9 +224,8 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         return !cancelled;
     };
     RefineSummary s;
-    s.result =
-        refiner->train(noise_views(job, in, report), target.data, judges.ref_rgb.empty() ? nullptr : &judges.ref_rgb,
-                       judges.vae.get(), judges.lpips.get(), o, on_iteration);
+    s.result = refiner->train(training_examples(job, noise_views(job, in, report), target, judges, report),
+                              judges.vae.get(), judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");
     char best[96];
     std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,

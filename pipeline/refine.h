@@ -3,6 +3,7 @@
 // writes refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json and decoded_refined.png.
 #pragma once
 #include "pipeline/progress.h"
+#include "pipeline/refiner_augment.h"
 #include "refiner/refiner.h"
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,6 +18,9 @@ struct RefineJob {
     /// more at the fit's final spp with independent samples (seeds no edit frame uses), so that it
     /// learns the scene, not one render's noise (docs/refiner.md "Noise views").
     int noise_views = 1;
+    /// Mirrored and rolled copies of the training view, each against its reference moved the same
+    /// way and encoded again (needs reference_rgb.exr; docs/refiner.md "Augmentation").
+    RefinerAugment augment = RefinerAugment::None;
     /// Apply the trained refiner on windows the size of its training crop (RefinerConfig::tile)
     /// when InstanceNorm is on and the crop is smaller than the view; false: the whole view at once.
     bool windowed_inference = true;

@@ -41,6 +41,13 @@ struct RefinerInput {
     std::vector<float> distance;  ///< width × height × 1 (0 where the camera ray escapes)
 };
 
+/// One training pair: a render of a view and what it should refine to.
+struct RefinerExample {
+    RefinerInput input;
+    std::vector<float> target;      ///< width × height × latent_channels
+    std::vector<float> target_rgb;  ///< 8 width × 8 height × 3 in [0, 1] for LPIPS; empty: the decoded target
+};
+
 struct RefinerTrainOptions {
     int iterations = 3000;
     float lr = 5e-4f;
@@ -103,6 +110,13 @@ public:
     /// view trains exactly as train() above.
     RefinerTrainResult train(const std::vector<RefinerInput>& noise_views, const std::vector<float>& target,
                              const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
+                             const RefinerTrainOptions& options,
+                             const std::function<bool(const RefinerRecord&)>& on_iteration = {});
+    /// The general form: each iteration's crop comes from one of the examples, drawn by (seed,
+    /// iteration), and each example brings its own target (augmented views of the training view,
+    /// docs/refiner.md "Augmentation"). Examples may differ in size; one example trains exactly
+    /// as train() above.
+    RefinerTrainResult train(const std::vector<RefinerExample>& examples, const Vae* vae, const Lpips* lpips,
                              const RefinerTrainOptions& options,
                              const std::function<bool(const RefinerRecord&)>& on_iteration = {});
 

@@ -1,7 +1,8 @@
 // Refiner training (stage 2): Adam on MSE + (1 − SSIM) of latents plus LPIPS of decoded crops,
-// on random crops of the training view so an iteration stays cheap on a CPU. Crop positions and
-// dropout masks are functions of (seed, iteration), so a resumed run repeats the same iterations
-// as an uninterrupted one.
+// on random crops of the training examples (the training view, and renders or augmented copies of
+// it) so an iteration stays cheap on a CPU. Example, crop positions and dropout masks are
+// functions of (seed, iteration), so a resumed run repeats the same iterations as an
+// uninterrupted one.
 #include "autodiff/lr_schedule.h"
 #include "core/sampler.h"
 #include "refiner/refiner_net.h"
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 
 namespace lpt {
@@ -136,55 +138,48 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
     std::filesystem::rename(tmp_path, path);
 }
 
-/// The training view as tensors and what each iteration's loss uses.
+/// The training examples as tensors and what each iteration's loss uses.
 struct TrainingData {
-    torch::Tensor x_all;           ///< inputs [views, C + 4, h, w]: renders of the view with independent noise
-    torch::Tensor y_all, rgb_all;  ///< target latent, target RGB (may be undefined)
+    std::vector<torch::Tensor> xs;    ///< inputs [1, C + 4, h, w] per example
+    std::vector<torch::Tensor> ys;    ///< target latents [1, C, h, w]
+    std::vector<torch::Tensor> rgbs;  ///< target RGB [1, 3, 8h, 8w]; undefined: the decoded target
     const TorchVae* vae = nullptr;
     const Lpips* lpips = nullptr;
-    int w = 0, h = 0, crop_w = 0, crop_h = 0, lp = 0;
+    int crop = 0, lpips_crop = 0;  ///< as asked; an example smaller than the crop is cropped to its size
     bool use_lpips = false, use_ssim = false;
 };
 
-/// The noise views stacked along the batch dimension; all must be of one size.
-torch::Tensor stacked_inputs(const std::vector<RefinerInput>& views, const RefinerConfig& cfg) {
-    if (views.empty()) throw std::invalid_argument("refiner: no training view");
-    std::vector<torch::Tensor> xs;
-    for (const RefinerInput& v : views) {
-        if (v.width != views[0].width || v.height != views[0].height)
-            throw std::invalid_argument("refiner: noise views must all be " + std::to_string(views[0].width) + "x" +
-                                        std::to_string(views[0].height));
-        xs.push_back(refiner_input_tensor(v, cfg));
-    }
-    return xs.size() == 1 ? xs[0] : torch::cat(xs, 0);
+torch::Tensor nchw(const std::vector<float>& hwc, int w, int h, int c) {
+    return torch::from_blob(const_cast<float*>(hwc.data()), {1, h, w, c}).permute({0, 3, 1, 2}).contiguous();
 }
 
-TrainingData training_data(const std::vector<RefinerInput>& views, const RefinerConfig& cfg,
-                           const std::vector<float>& target, const std::vector<float>* target_rgb, const Vae* vae,
+/// Side of the training crop in an example `size` pixels long (0: the whole view).
+int crop_side(int crop, int64_t size) { return crop > 0 ? std::min(crop, int(size)) : int(size); }
+
+TrainingData training_data(const std::vector<RefinerExample>& examples, const RefinerConfig& cfg, const Vae* vae,
                            const Lpips* lpips, const RefinerTrainOptions& o) {
+    if (examples.empty()) throw std::invalid_argument("refiner: no training view");
     TrainingData d;
-    d.x_all = stacked_inputs(views, cfg);
-    d.w = views[0].width;
-    d.h = views[0].height;
-    const int w = d.w, h = d.h, c = cfg.latent_channels;
-    if (int64_t(target.size()) != int64_t(w) * h * c)
-        throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" + std::to_string(h) +
-                                    "x" + std::to_string(c));
-    d.y_all = torch::from_blob(const_cast<float*>(target.data()), {1, h, w, c}).permute({0, 3, 1, 2}).contiguous();
-    if (target_rgb) {
-        if (int64_t(target_rgb->size()) != int64_t(64) * w * h * 3)
+    const int c = cfg.latent_channels;
+    int smallest = std::numeric_limits<int>::max();
+    for (const RefinerExample& e : examples) {
+        const int w = e.input.width, h = e.input.height;
+        d.xs.push_back(refiner_input_tensor(e.input, cfg));
+        if (int64_t(e.target.size()) != int64_t(w) * h * c)
+            throw std::invalid_argument("refiner: target latent must be " + std::to_string(w) + "x" +
+                                        std::to_string(h) + "x" + std::to_string(c));
+        d.ys.push_back(nchw(e.target, w, h, c));
+        if (!e.target_rgb.empty() && int64_t(e.target_rgb.size()) != int64_t(64) * w * h * 3)
             throw std::invalid_argument("refiner: target RGB must be 8w x 8h x 3");
-        d.rgb_all = torch::from_blob(const_cast<float*>(target_rgb->data()), {1, 8 * h, 8 * w, 3})
-                        .permute({0, 3, 1, 2})
-                        .contiguous();
+        d.rgbs.push_back(e.target_rgb.empty() ? torch::Tensor() : nchw(e.target_rgb, 8 * w, 8 * h, 3));
+        smallest = std::min({smallest, crop_side(o.crop, w), crop_side(o.crop, h)});
     }
     d.vae = vae ? torch_vae(*vae) : nullptr;
     d.lpips = lpips;
-    d.crop_w = o.crop > 0 ? std::min(o.crop, w) : w;
-    d.crop_h = o.crop > 0 ? std::min(o.crop, h) : h;
-    d.lp = std::min({o.lpips_crop, d.crop_w, d.crop_h});
-    d.use_lpips = d.vae && lpips && o.w_lpips > 0.f && d.lp > 0 && 8 * d.lp >= Lpips::kMinSize;
-    d.use_ssim = o.w_ssim > 0.f && d.crop_w >= kSsimWindow && d.crop_h >= kSsimWindow;
+    d.crop = o.crop;
+    d.lpips_crop = std::min(o.lpips_crop, smallest);
+    d.use_lpips = d.vae && lpips && o.w_lpips > 0.f && d.lpips_crop > 0 && 8 * d.lpips_crop >= Lpips::kMinSize;
+    d.use_ssim = o.w_ssim > 0.f && smallest >= kSsimWindow;
     return d;
 }
 
@@ -193,11 +188,14 @@ TrainingData training_data(const std::vector<RefinerInput>& views, const Refiner
 torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTrainOptions& o, int it,
                         RefinerRecord& r) {
     const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
-    torch::manual_seed(key);  // dropout masks
-    const int cx = pick(key + 1, d.w - d.crop_w), cy = pick(key + 2, d.h - d.crop_h);
-    const int view = pick(key + 5, int(d.x_all.size(0)) - 1);  // 0 without drawing when there is one view
-    torch::Tensor x = d.x_all.narrow(0, view, 1).narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
-    torch::Tensor y = d.y_all.narrow(2, cy, d.crop_h).narrow(3, cx, d.crop_w);
+    torch::manual_seed(key);                               // dropout masks
+    const int view = pick(key + 5, int(d.xs.size()) - 1);  // 0 without drawing when there is one example
+    const torch::Tensor& x_view = d.xs[size_t(view)];
+    const int w = int(x_view.size(3)), h = int(x_view.size(2));
+    const int crop_w = crop_side(d.crop, w), crop_h = crop_side(d.crop, h);
+    const int cx = pick(key + 1, w - crop_w), cy = pick(key + 2, h - crop_h);
+    torch::Tensor x = x_view.narrow(2, cy, crop_h).narrow(3, cx, crop_w);
+    torch::Tensor y = d.ys[size_t(view)].narrow(2, cy, crop_h).narrow(3, cx, crop_w);
     torch::Tensor out = net->forward(x);
     torch::Tensor mse = torch::mse_loss(out, y);
     torch::Tensor loss = o.w_mse * mse;
@@ -209,11 +207,11 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
         r.dssim = dssim.item<double>();
     }
     if (d.use_lpips) {
-        const int lp = d.lp, lx = pick(key + 3, d.crop_w - lp), ly = pick(key + 4, d.crop_h - lp);
+        const int lp = d.lpips_crop, lx = pick(key + 3, crop_w - lp), ly = pick(key + 4, crop_h - lp);
         torch::Tensor dec = d.vae->decode_nchw(out.narrow(2, ly, lp).narrow(3, lx, lp));
         torch::Tensor ref;
-        if (d.rgb_all.defined()) {
-            ref = d.rgb_all.narrow(2, 8 * (cy + ly), 8 * lp).narrow(3, 8 * (cx + lx), 8 * lp);
+        if (d.rgbs[size_t(view)].defined()) {
+            ref = d.rgbs[size_t(view)].narrow(2, 8 * (cy + ly), 8 * lp).narrow(3, 8 * (cx + lx), 8 * lp);
         } else {
             torch::NoGradGuard no_grad;
             ref = d.vae->decode_nchw(y.narrow(2, ly, lp).narrow(3, lx, lp));
@@ -254,9 +252,22 @@ RefinerTrainResult Refiner::train(const std::vector<RefinerInput>& noise_views, 
                                   const std::vector<float>* target_rgb, const Vae* vae, const Lpips* lpips,
                                   const RefinerTrainOptions& o,
                                   const std::function<bool(const RefinerRecord&)>& on_iteration) {
+    std::vector<RefinerExample> examples;
+    for (const RefinerInput& v : noise_views) {
+        if (v.width != noise_views[0].width || v.height != noise_views[0].height)
+            throw std::invalid_argument("refiner: noise views must all be " + std::to_string(noise_views[0].width) +
+                                        "x" + std::to_string(noise_views[0].height));
+        examples.push_back({v, target, target_rgb ? *target_rgb : std::vector<float>{}});
+    }
+    return train(examples, vae, lpips, o, on_iteration);
+}
+
+RefinerTrainResult Refiner::train(const std::vector<RefinerExample>& examples, const Vae* vae, const Lpips* lpips,
+                                  const RefinerTrainOptions& o,
+                                  const std::function<bool(const RefinerRecord&)>& on_iteration) {
     RefinerNet& net = m->net;
     const RefinerConfig& cfg = m->config;
-    const TrainingData data = training_data(noise_views, cfg, target, target_rgb, vae, lpips, o);
+    const TrainingData data = training_data(examples, cfg, vae, lpips, o);
     TrainingState s(net, o);
     if (o.resume) load_checkpoint(o.checkpoint_path, net, cfg, s);
     const double seconds_before = s.result.history.empty() ? 0.0 : s.result.history.back().seconds;

@@ -76,6 +76,14 @@ VARIANTS = {
                               MSE + ["--lr-decay", "cosine", "--inference", "whole"], False, 6000),
     "mse_6000_cosine_windows": ("mse_6000_cosine applied on windows of its 32² training crop, stride 16, averaged",
                                 MSE + ["--lr-decay", "cosine", "--inference", "windows"], False, 6000),
+    "mse_6000_cosine_mirror": ("mse_6000_cosine (windows) also on the training view's mirror image, against its "
+                               "mirrored reference encoded again", MSE + ["--lr-decay", "cosine", "--augment", "mirror"],
+                               False, 6000),
+    "mse_12000_cosine_mirror": ("mse_6000_cosine_mirror with twice the steps: as many per view as mse_6000_cosine",
+                                MSE + ["--lr-decay", "cosine", "--augment", "mirror"], False, 12000),
+    "mse_6000_cosine_dihedral": ("mse_6000_cosine (windows) on the training view, its mirror image and both rolled "
+                                 "by quarter turns (8 views)", MSE + ["--lr-decay", "cosine", "--augment", "dihedral"],
+                                 False, 6000),
     "mse_9000_cosine": ("latent MSE alone for 9000 iterations, lr falling along a half cosine to 0",
                         MSE + ["--lr-decay", "cosine"], False, 9000),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),

@@ -105,6 +105,11 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q $small_refiner --out "$out/enc"
     for f in reference.png reference_rgb.exr target.exr target_decoded.png decoded.png decoded_refined.png metrics.json; do check test -s "$out/enc/$f"; done
     check grep -q vae_roundtrip "$out/enc/metrics.json"
+    # Augmented views from the fit's own reference: trained, recorded; a bad name is refused.
+    cp -r "$out/enc" "$out/enc_aug"
+    "$bin" refine "$out/enc_aug" --iterations 6 --expansion 1 -q --augment dihedral
+    check grep -q '"augment": "dihedral"' "$out/enc_aug/metrics.json"
+    expect_error "augment" "$bin" refine "$out/enc_aug" -q --augment flip
     # Fits sharing a training reference through --reference-cache: traced once, the same target
     # as a fit that traces its own.
     for d in encc1 encc2; do

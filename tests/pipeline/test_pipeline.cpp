@@ -138,3 +138,23 @@ TEST(Pipeline, RefinerNoiseViewsAreRenderedFromTheFit) {
         EXPECT_NE(std::string(e.what()).find("fit.json"), std::string::npos) << e.what();
     }
 }
+
+// Augmented views need the path-traced reference they are encoded from: a fit with a synthetic
+// target has none, and asking for them is an error naming the missing file. (Their training is
+// tested in tests/refiner, their pixels and the renders they stand for in test_refiner_augment.)
+TEST(Pipeline, RefinerAugmentationNeedsThePathTracedReference) {
+    const std::string dir = test::temp_dir("pipeline-augment");
+    pipeline::run_fit(small_fit(dir + "/fit"));
+    pipeline::RefineJob r;
+    r.fitdir = dir + "/fit";
+    r.net.expansion = 1;
+    r.train.iterations = 4;
+    r.augment = pipeline::RefinerAugment::Mirror;
+    try {
+        pipeline::run_refine(r);
+        ADD_FAILURE() << "augmentation without reference_rgb.exr was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("reference_rgb.exr"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--refiner-augment mirror"), std::string::npos) << e.what();
+    }
+}

@@ -1,6 +1,6 @@
 // Refiner (stage 2): identity at start, training lowers the loss on a problem it can solve,
 // save/load and checkpoint/resume reproduce outputs exactly, LPIPS through the TAESD3 decoder
-// gives finite gradients, noise views are drawn evenly, cosine decay scales the steps, windowed
+// gives finite gradients, noise views and examples are drawn evenly, cosine decay scales the steps, windowed
 // inference averages the windows it says, and bad files are clear errors.
 #include "autodiff/fit.h"
 #include "core/scene_loader.h"
@@ -169,6 +169,47 @@ TEST(Refiner, NoiseViewsAreDrawnEvenlyAndOneViewTrainsAsBefore) {
 
     views[1].width = 8;
     EXPECT_THROW(r->train(views, p.target, nullptr, nullptr, nullptr, still), std::invalid_argument);
+}
+
+// Examples (augmented views) bring their own target and may differ in size: with lr 0 the
+// network stays the identity, so example k, whose target is its latent − k, shows as latent MSE k²
+// in the iterations that drew it; all are drawn about equally often, the 16 × 12 one (a turned
+// 12 × 16 view) with crops that fit it; one example trains exactly as the single-view call; a
+// target of the wrong size is an error.
+TEST(Refiner, ExamplesBringTheirOwnTargetsAndSizes) {
+    Problem p = make_problem(12, 16), q = make_problem(16, 12);
+    RefinerConfig cfg = small();
+    cfg.dropout = 0.1f;
+    auto single = Refiner::create(cfg, 3), one = Refiner::create(cfg, 3);
+    const RefinerTrainOptions o = latent_training(20, 10);
+    single->train(p.in, p.target, nullptr, nullptr, nullptr, o);
+    one->train(std::vector<RefinerExample>{{p.in, p.target, {}}}, nullptr, nullptr, o);
+    EXPECT_EQ(single->refine(p.in), one->refine(p.in));
+
+    std::vector<RefinerExample> examples;
+    for (int k = 0; k < 3; ++k) {
+        const Problem& src = k == 1 ? q : p;
+        RefinerExample e{src.in, src.in.latent, {}};
+        for (float& v : e.target) v -= float(k);
+        examples.push_back(e);
+    }
+    RefinerTrainOptions still = latent_training(150, 14);
+    still.lr = 0.f;
+    still.w_ssim = 0.f;
+    auto r = Refiner::create(cfg, 5);
+    const RefinerTrainResult res = r->train(examples, nullptr, nullptr, still);
+    int drawn[3] = {0, 0, 0};
+    for (const RefinerRecord& rec : res.history) {
+        const int k = int(std::lround(std::sqrt(rec.mse)));
+        ASSERT_LT(k, 3) << "iteration " << rec.iteration;
+        ASSERT_NEAR(rec.mse, double(k * k), 1e-6) << "iteration " << rec.iteration;
+        ++drawn[k];
+    }
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(drawn[k], 50, 25) << "example " << k;  // binomial sd 5.8
+
+    examples[2].target.pop_back();
+    EXPECT_THROW(r->train(examples, nullptr, nullptr, still), std::invalid_argument);
+    EXPECT_THROW(r->train(std::vector<RefinerExample>{}, nullptr, nullptr, still), std::invalid_argument);
 }
 
 // Cosine decay: step i uses lr · (1 + cos(π i / N)) / 2. Two runs of N = 2 steps from one start,
