@@ -12,9 +12,12 @@ RefinerAugment parse_refiner_augment(const std::string& name) {
 
 std::string to_string(RefinerAugment a) {
     switch (a) {
-        case RefinerAugment::Mirror: return "mirror";
-        case RefinerAugment::Dihedral: return "dihedral";
-        default: return "none";
+        case RefinerAugment::Mirror:
+            return "mirror";
+        case RefinerAugment::Dihedral:
+            return "dihedral";
+        default:
+            return "none";
     }
 }
 

@@ -81,6 +81,17 @@ VARIANTS = {
                                False, 6000),
     "mse_12000_cosine_mirror": ("mse_6000_cosine_mirror with twice the steps: as many per view as mse_6000_cosine",
                                 MSE + ["--lr-decay", "cosine", "--augment", "mirror"], False, 12000),
+    # Several views make the smoothed crop loss jump between views' levels: patience 500 stopped
+    # the three above at 4340, 4251 and 7437 steps, before their schedules ended. These run it all.
+    "mse_6000_cosine_mirror_all": ("mse_6000_cosine_mirror without early stopping (the whole cosine period)",
+                                   MSE + ["--lr-decay", "cosine", "--augment", "mirror", "--patience", "0"], False,
+                                   6000),
+    "mse_6000_cosine_dihedral_all": ("mse_6000_cosine_dihedral without early stopping (the whole cosine period)",
+                                     MSE + ["--lr-decay", "cosine", "--augment", "dihedral", "--patience", "0"],
+                                     False, 6000),
+    "mse_6000_cosine_noise8_all": ("mse_6000_cosine on 8 renders of the training view (noise views), without early "
+                                   "stopping (noise_views_8 stopped at 2538 of 3000 steps)",
+                                   MSE + ["--lr-decay", "cosine", "--noise-views", "8", "--patience", "0"], False, 6000),
     "mse_6000_cosine_dihedral": ("mse_6000_cosine (windows) on the training view, its mirror image and both rolled "
                                  "by quarter turns (8 views)", MSE + ["--lr-decay", "cosine", "--augment", "dihedral"],
                                  False, 6000),
@@ -147,7 +158,7 @@ def evaluate(a, vdir, kind):
     edited = [r for r in rows if int(r["frame"]) != 0]
     return {"lpips": X.mean(rows, "refined_rgb_lpips"), "mse_x100": X.mean(rows, "refined_rgb_mse_x100"),
             "edited_lpips": X.mean(edited, "refined_rgb_lpips"), "edited_mse_x100": X.mean(edited, "refined_rgb_mse_x100"),
-            "frames": [int(r["frame"]) for r in rows]}
+            "edited_latent_mse": X.mean(edited, "refined_latent_mse"), "frames": [int(r["frame"]) for r in rows]}
 
 
 def training_view(vdir):
@@ -157,6 +168,21 @@ def training_view(vdir):
             "reference": m.get("reference", "")}
 
 
+def earlier_results(a):
+    """Rows of earlier runs of this study whose variant folders are still there, so that study.md
+    keeps every variant measured on the scene folder, not only this run's."""
+    path = os.path.join(a.scene_dir, "refiner_study", "study.json")
+    if not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        rows = json.load(f)
+    start, stop, step = (int(v) for v in a.frames.split(":"))
+    frames = list(range(start, stop + 1, step))
+    return {name: r for name, r in rows.items()
+            if name in VARIANTS and all(k in r and r[k].get("frames") == frames for k in a.kinds) and
+            os.path.exists(os.path.join(a.scene_dir, "refiner_study", name, "refine.done"))}
+
+
 def report(a, results):
     md = [f"# Refiner study on {a.scene_dir}", "",
           f"Stage-1 fit {a.fit}; refiner {a.iterations} iterations unless the variant names its own "
@@ -164,14 +190,16 @@ def report(a, results):
           f"frames {a.frames} of each edit sequence at {a.spp} spp "
           f"against {a.ref_spp}-spp references. Mean refined LPIPS / MSE×100 (edit columns include frame 0, the "
           "training view, as the paper's means do; 'edited' excludes it). Choose by the edit means.", "",
-          "| variant | what | " + " | ".join(a.kinds) + " | edited mean | training view |",
-          "|---|---|" + "---|" * (len(a.kinds) + 2)]
+          "| variant | what | " + " | ".join(a.kinds) + " | edited mean | edited latent MSE | training view |",
+          "|---|---|" + "---|" * (len(a.kinds) + 3)]
     for name, r in results.items():
         cells = [f"{r[k]['lpips']:.4f} / {r[k]['mse_x100']:.4f}" for k in a.kinds]
         el = sum(r[k]["edited_lpips"] for k in a.kinds) / len(a.kinds)
         em = sum(r[k]["edited_mse_x100"] for k in a.kinds) / len(a.kinds)
+        lat = [r[k].get("edited_latent_mse") for k in a.kinds]
+        lat_cell = f"{sum(lat) / len(lat):.5f}" if None not in lat else "–"
         t = r["training_view"]
-        md.append(f"| {name} | {VARIANTS[name][0]} | " + " | ".join(cells) + f" | {el:.4f} / {em:.4f} | "
+        md.append(f"| {name} | {VARIANTS[name][0]} | " + " | ".join(cells) + f" | {el:.4f} / {em:.4f} | {lat_cell} | "
                   f"{t['lpips']:.4f} / {t['mse_x100']:.4f} |")
     out = os.path.join(a.scene_dir, "refiner_study")
     X.write_atomic(os.path.join(out, "study.md"), "\n".join(md) + "\n")
@@ -223,7 +251,7 @@ def main():
     for name in a.variants.split(","):
         if name not in VARIANTS:
             sys.exit(f"refiner_study: unknown variant '{name}' (have {', '.join(VARIANTS)})")
-    results = {}
+    results = earlier_results(a)
     for name in a.variants.split(","):
         vdir = os.path.join(a.scene_dir, "refiner_study", name)
         train_variant(a, name, vdir)

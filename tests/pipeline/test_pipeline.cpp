@@ -30,6 +30,16 @@ pipeline::FitJob small_fit(const std::string& out) {
     return job;
 }
 
+/// A small fit in <dir>/fit and a stage-2 job on it (the narrowest network).
+pipeline::RefineJob small_refine(const std::string& dir, int iterations) {
+    pipeline::run_fit(small_fit(dir + "/fit"));
+    pipeline::RefineJob r;
+    r.fitdir = dir + "/fit";
+    r.net.expansion = 1;
+    r.train.iterations = iterations;
+    return r;
+}
+
 pipeline::Reporter cancel_after(int step) {
     pipeline::Reporter r;
     r.progress = [step](const pipeline::StageProgress& p) { return p.step < step; };
@@ -108,12 +118,7 @@ TEST(Pipeline, EditSessionFramesEqualTheRenderedFiles) {
 // records differ once another view is drawn), the record says how many, and a fit.json that
 // cannot say the final render's spp is an error naming the field.
 TEST(Pipeline, RefinerNoiseViewsAreRenderedFromTheFit) {
-    const std::string dir = test::temp_dir("pipeline-noise-views");
-    pipeline::run_fit(small_fit(dir + "/fit"));
-    pipeline::RefineJob r;
-    r.fitdir = dir + "/fit";
-    r.net.expansion = 1;
-    r.train.iterations = 12;
+    pipeline::RefineJob r = small_refine(test::temp_dir("pipeline-noise-views"), 12);
     r.train.patience = 0;
     const pipeline::RefineSummary one = pipeline::run_refine(r);
     r.noise_views = 3;
@@ -143,12 +148,7 @@ TEST(Pipeline, RefinerNoiseViewsAreRenderedFromTheFit) {
 // target has none, and asking for them is an error naming the missing file. (Their training is
 // tested in tests/refiner, their pixels and the renders they stand for in test_refiner_augment.)
 TEST(Pipeline, RefinerAugmentationNeedsThePathTracedReference) {
-    const std::string dir = test::temp_dir("pipeline-augment");
-    pipeline::run_fit(small_fit(dir + "/fit"));
-    pipeline::RefineJob r;
-    r.fitdir = dir + "/fit";
-    r.net.expansion = 1;
-    r.train.iterations = 4;
+    pipeline::RefineJob r = small_refine(test::temp_dir("pipeline-augment"), 4);
     r.augment = pipeline::RefinerAugment::Mirror;
     try {
         pipeline::run_refine(r);

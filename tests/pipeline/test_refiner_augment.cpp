@@ -105,8 +105,8 @@ TEST(RefinerAugment, TheMovesAreTheDihedralGroupAndMoveRgbAsTheLatent) {
     const std::vector<float> rgb = random_image(8 * w, 8 * h, 3, 2);
     for (const ViewTransform& t : all) {
         const bool swap = t.quarter_turns % 2 != 0;
-        const std::vector<float> a = box_down(transform_image(rgb, 8 * w, 8 * h, 3, t), swap ? 8 * h : 8 * w,
-                                              swap ? 8 * w : 8 * h, 3, 8);
+        const std::vector<float> a =
+            box_down(transform_image(rgb, 8 * w, 8 * h, 3, t), swap ? 8 * h : 8 * w, swap ? 8 * w : 8 * h, 3, 8);
         const std::vector<float> b = transform_image(box_down(rgb, 8 * w, 8 * h, 3, 8), w, h, 3, t);
         ASSERT_EQ(a.size(), b.size());
         for (size_t i = 0; i < a.size(); ++i)

@@ -67,6 +67,12 @@ def check_refiner_study(a, scene_dir, edits):
         assert dssim > 0 and lpips == 0 and close(loss, mse + dssim, 1e-5), f"mse_ssim's loss row {r}"
     assert not close(study["mse_ssim"]["camera"]["mse_x100"], study["default"]["camera"]["mse_x100"]), \
         "the retrained refiner scores exactly as the fit's: it was not retrained"
+    again = run[:run.index("--variants") + 1] + ["default"] + run[run.index("--variants") + 2:]
+    subprocess.run(again, check=True, stdout=subprocess.DEVNULL)
+    with open(os.path.join(scene_dir, "refiner_study", "study.json")) as f:
+        kept = json.load(f)
+    assert kept.get("mse_ssim") == study["mse_ssim"] and kept["default"] == study["default"], \
+        "a later run of one variant dropped or changed another variant's row of study.json"
     other = subprocess.run(run[:-1] + ["21"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     assert other.returncode != 0 and "other settings" in other.stderr, \
         f"a folder made with 20 iterations was reused for 21 (exit {other.returncode}: {other.stderr})"
