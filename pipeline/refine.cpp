@@ -224,8 +224,15 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         return !cancelled;
     };
     RefineSummary s;
-    s.result = refiner->train(training_examples(job, noise_views(job, in, report), target, judges, report),
-                              judges.vae.get(), judges.lpips.get(), o, on_iteration);
+    const std::vector<RefinerExample> examples =
+        training_examples(job, noise_views(job, in, report), target, judges, report);
+    if (examples.size() > 1 && o.patience > 0)
+        report.say("note: " + std::to_string(examples.size()) + " training views with early stopping (patience " +
+                   std::to_string(o.patience) +
+                   "): the crop loss jumps between the views, which can stop training long before its schedule "
+                   "ends; patience 0 (fit --refiner-patience 0, refine --patience 0) runs every step (docs/refiner.md "
+                   "\"Augmentation\")");
+    s.result = refiner->train(examples, judges.vae.get(), judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");
     char best[96];
     std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,
