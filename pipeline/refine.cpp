@@ -121,11 +121,11 @@ nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vec
 uint64_t noise_view_seed(uint64_t fit_seed, int k) { return mix64(fit_seed ^ mix64(0x6e6f697365ull + uint64_t(k))); }
 
 /// The fit's own view first, then job.noise_views − 1 renders of the same camera with other seeds.
-std::vector<RefinerInput> noise_views(const RefineJob& job, RefinerInput fit_view, const Reporter& report) {
+std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit, RefinerInput fit_view,
+                                      const Reporter& report) {
     std::vector<RefinerInput> views;
     views.push_back(std::move(fit_view));
     if (job.noise_views <= 1) return views;
-    const FitFolder fit = load_fit_folder(job.fitdir);
     const int spp = fit.manifest.value("stage1", nlohmann::json::object()).value("final_spp", 0);
     if (spp <= 0)
         throw std::runtime_error((fs::path(job.fitdir) / "fit.json").string() +
@@ -141,15 +141,12 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, RefinerInput fit_vie
     return views;
 }
 
-/// The camera's x axis in world space, unit length: the normal of the plane a mirrored view
-/// reflects the world across.
-Vec3f camera_right(const Scene& scene) { return scene.camera.world_from_camera.vector(Vec3f::UnitX()).normalized(); }
-
 /// The training examples: every noise view against the target, then (job.augment) every noise
 /// view moved by each other transform, against the reference image moved the same way and
 /// encoded again (docs/refiner.md "Augmentation").
-std::vector<RefinerExample> training_examples(const RefineJob& job, const std::vector<RefinerInput>& views,
-                                              const Image& target, const Judges& judges, const Reporter& report) {
+std::vector<RefinerExample> training_examples(const RefineJob& job, const FitFolder& fit,
+                                              const std::vector<RefinerInput>& views, const Image& target,
+                                              const Judges& judges, const Reporter& report) {
     std::vector<RefinerExample> examples;
     for (const RefinerInput& v : views) examples.push_back({v, target.data, judges.ref_rgb});
     const std::vector<ViewTransform> moves = augment_transforms(job.augment);
@@ -160,11 +157,11 @@ std::vector<RefinerExample> training_examples(const RefineJob& job, const std::v
                                  (judges.path_traced ? "(no VAE found)" : "(missing: fit with --encode)"));
     report.say("[refine] " + std::to_string(moves.size() - 1) + " augmented views (" + to_string(job.augment) +
                "): encoding their references");
-    const Vec3f right = camera_right(*load_fit_folder(job.fitdir).scene);
+    const Vec3f right = mirror_plane_normal(fit.scene->camera);
     const int iw = 8 * target.width, ih = 8 * target.height;
     for (size_t m = 1; m < moves.size(); ++m) {
         std::vector<float> rgb = transform_image(judges.ref_rgb, iw, ih, 3, moves[m]);
-        const bool swap = moves[m].quarter_turns % 2 != 0;
+        const bool swap = moves[m].swaps_axes();
         std::vector<float> moved_target = judges.vae->encode(rgb, swap ? ih : iw, swap ? iw : ih);
         for (const RefinerInput& v : views) examples.push_back({transform_view(v, moves[m], right), moved_target, rgb});
     }
@@ -224,8 +221,11 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         return !cancelled;
     };
     RefineSummary s;
+    // The fitted scene (a load of the scene and its BVH) only when extra views need it.
+    const bool needs_fit = job.noise_views > 1 || job.augment != RefinerAugment::None;
+    const FitFolder fit = needs_fit ? load_fit_folder(job.fitdir) : FitFolder{};
     const std::vector<RefinerExample> examples =
-        training_examples(job, noise_views(job, in, report), target, judges, report);
+        training_examples(job, fit, noise_views(job, fit, in, report), target, judges, report);
     if (examples.size() > 1 && o.patience > 0)
         report.say("note: " + std::to_string(examples.size()) + " training views with early stopping (patience " +
                    std::to_string(o.patience) +

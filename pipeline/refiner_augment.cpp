@@ -54,8 +54,7 @@ std::vector<float> transform_image(const std::vector<float>& image, int w, int h
     if (image.size() != size_t(w) * size_t(h) * size_t(c))
         throw std::invalid_argument("transform_image: buffer is not " + std::to_string(w) + "x" + std::to_string(h) +
                                     "x" + std::to_string(c));
-    const bool swap = t.quarter_turns % 2 != 0;
-    const int ow = swap ? h : w, oh = swap ? w : h;
+    const int ow = t.swaps_axes() ? h : w, oh = t.swaps_axes() ? w : h;
     std::vector<float> out(image.size());
     for (int oy = 0; oy < oh; ++oy)
         for (int ox = 0; ox < ow; ++ox) {
@@ -70,9 +69,8 @@ std::vector<float> transform_image(const std::vector<float>& image, int w, int h
 
 RefinerInput transform_view(const RefinerInput& in, ViewTransform t, const Vec3f& camera_right) {
     RefinerInput out;
-    const bool swap = t.quarter_turns % 2 != 0;
-    out.width = swap ? in.height : in.width;
-    out.height = swap ? in.width : in.height;
+    out.width = t.swaps_axes() ? in.height : in.width;
+    out.height = t.swaps_axes() ? in.width : in.height;
     const int c = in.width * in.height > 0 ? int(in.latent.size() / (size_t(in.width) * size_t(in.height))) : 0;
     out.latent = transform_image(in.latent, in.width, in.height, c, t);
     out.normal = transform_image(in.normal, in.width, in.height, 3, t);
@@ -85,5 +83,7 @@ RefinerInput transform_view(const RefinerInput& in, ViewTransform t, const Vec3f
         }
     return out;
 }
+
+Vec3f mirror_plane_normal(const Camera& camera) { return camera.world_from_camera.vector(Vec3f::UnitX()).normalized(); }
 
 }  // namespace lpt::pipeline

@@ -7,6 +7,7 @@
 // mirror(enc(I)) by latent MSE 0.028, the size of the rendered latent's own error), so the new
 // targets are new information. docs/refiner.md "Augmentation".
 #pragma once
+#include "core/camera.h"
 #include "core/geometry.h"
 #include "refiner/refiner.h"
 #include <string>
@@ -27,6 +28,8 @@ std::string to_string(RefinerAugment a);
 struct ViewTransform {
     int quarter_turns = 0;
     bool mirror = false;
+    /// Whether the moved image is h × w (odd turns) rather than w × h.
+    bool swaps_axes() const { return quarter_turns % 2 != 0; }
 };
 
 /// The identity first, then the other transforms of the augmentation.
@@ -38,5 +41,8 @@ std::vector<float> transform_image(const std::vector<float>& image, int w, int h
 /// mirror, each normal is also reflected across the plane whose normal is `camera_right` (the
 /// camera's x axis in world space, unit length), as the mirrored world's normals are.
 RefinerInput transform_view(const RefinerInput& in, ViewTransform t, const Vec3f& camera_right);
+/// The camera's x axis in world space, unit length: the normal of the plane through the camera
+/// that a mirrored view reflects the world across (it maps the camera onto itself).
+Vec3f mirror_plane_normal(const Camera& camera);
 
 }  // namespace lpt::pipeline

@@ -8,9 +8,9 @@
 #include "core/scene_spectra.h"
 #include "integrators/aov.h"
 #include "pipeline/refiner_augment.h"
+#include "test_util.h"
 #include <gtest/gtest.h>
 #include <cmath>
-#include <random>
 #include <set>
 
 using namespace lpt;
@@ -23,12 +23,8 @@ namespace {
 
 const std::string kCornell = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json";
 
-std::vector<float> random_image(int w, int h, int c, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-1.f, 1.f);
-    std::vector<float> img(size_t(w) * size_t(h) * size_t(c));
-    for (float& v : img) v = u(rng);
-    return img;
+std::vector<float> random_image(int w, int h, int c, uint64_t seed) {
+    return test::random_weights(size_t(w) * size_t(h) * size_t(c), seed);
 }
 
 /// Mean over f × f blocks (how a latent pixel covers its 8 × 8 RGB pixels).
@@ -61,8 +57,6 @@ double mean_abs(const std::vector<float>& a, const std::vector<float>& b) {
     for (size_t i = 0; i < a.size() && i < b.size(); ++i) s += std::abs(double(a[i]) - double(b[i]));
     return s / double(a.size());
 }
-
-Vec3f camera_right(const Scene& s) { return s.camera.world_from_camera.vector(Vec3f::UnitX()).normalized(); }
 
 }  // namespace
 
@@ -104,7 +98,7 @@ TEST(RefinerAugment, TheMovesAreTheDihedralGroupAndMoveRgbAsTheLatent) {
     // reference and the latent-resolution buffers stay registered under every move.
     const std::vector<float> rgb = random_image(8 * w, 8 * h, 3, 2);
     for (const ViewTransform& t : all) {
-        const bool swap = t.quarter_turns % 2 != 0;
+        const bool swap = t.swaps_axes();
         const std::vector<float> a =
             box_down(transform_image(rgb, 8 * w, 8 * h, 3, t), swap ? 8 * h : 8 * w, swap ? 8 * w : 8 * h, 3, 8);
         const std::vector<float> b = transform_image(box_down(rgb, 8 * w, 8 * h, 3, 8), w, h, 3, t);
@@ -140,13 +134,13 @@ TEST(RefinerAugment, MirrorReflectsNormalsAcrossTheCameraPlaneAndTurnsKeepThem) 
 // What the renderer sees. Rolling the camera by a quarter turn about its view axis turns the
 // image by a quarter turn, one way or the other; the test finds which from the renders and
 // requires one to match within sampling noise and the other not. The mirrored world (every mesh
-// reflected across the plane through the camera's origin with normal camera_right, which maps
-// the camera onto itself) must render as transform_view's mirror, reflected normals included.
+// reflected across the plane through the camera's origin with normal mirror_plane_normal, which
+// maps the camera onto itself) must render as transform_view's mirror, reflected normals included.
 TEST(RefinerAugment, RolledCameraAndMirroredWorldRenderTheMovedViews) {
     const int n = 24;
     Scene scene = load_scene(kCornell);
     const RefinerInput view = aov_view(scene, n, n);
-    const Vec3f right = camera_right(scene);
+    const Vec3f right = pipeline::mirror_plane_normal(scene.camera);
 
     Scene rolled = load_scene(kCornell);
     rolled.camera.world_from_camera = rolled.camera.world_from_camera * Transform::rotate(Vec3f::UnitZ(), 90.f);
