@@ -95,6 +95,17 @@ VARIANTS = {
     "mse_6000_cosine_dihedral": ("mse_6000_cosine (windows) on the training view, its mirror image and both rolled "
                                  "by quarter turns (8 views)", MSE + ["--lr-decay", "cosine", "--augment", "dihedral"],
                                  False, 6000),
+    # Regularisation and capacity on top of the preset's refiner (windows, one view, run as it stops).
+    "mse_6000_cosine_no_dropout": ("mse_6000_cosine without dropout", MSE + ["--lr-decay", "cosine", "--dropout", "0"],
+                                   False, 6000),
+    "mse_6000_cosine_dropout_0.2": ("mse_6000_cosine with twice the dropout (0.2)",
+                                    MSE + ["--lr-decay", "cosine", "--dropout", "0.2"], False, 6000),
+    "mse_6000_cosine_expansion_8": ("mse_6000_cosine at half the width (expansion 8: 128 channels)",
+                                    MSE + ["--lr-decay", "cosine", "--expansion", "8"], False, 6000),
+    # Early stopping on the mean of per-view EMAs (since 2026-11-26, session 12) instead of one EMA
+    # of the mixed crop losses: the same options as mse_6000_cosine_dihedral, which stopped at 4251.
+    "mse_6000_cosine_dihedral_per_view": ("mse_6000_cosine_dihedral with early stopping on the mean of per-view EMAs",
+                                          MSE + ["--lr-decay", "cosine", "--augment", "dihedral"], False, 6000),
     "mse_9000_cosine": ("latent MSE alone for 9000 iterations, lr falling along a half cosine to 0",
                         MSE + ["--lr-decay", "cosine"], False, 9000),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),

@@ -212,6 +212,62 @@ TEST(Refiner, ExamplesBringTheirOwnTargetsAndSizes) {
     EXPECT_THROW(r->train(std::vector<RefinerExample>{}, nullptr, nullptr, still), std::invalid_argument);
 }
 
+// Early stopping follows the mean over examples of each example's EMA of its crop loss, not one
+// EMA of the mixed losses, which jumps with the example drawn. With lr 0 example k (target =
+// latent − k) always scores k², so once all three are drawn the smoothed loss is (0 + 1 + 4) / 3
+// at every step, whichever example the step drew, and training stops `patience` steps after the
+// smoothed loss last fell. A resumed run restores every example's EMA.
+TEST(Refiner, TheSmoothedLossIsTheMeanOfEachExamplesEma) {
+    Problem p = make_problem(12, 12);
+    std::vector<RefinerExample> examples;
+    for (int k = 0; k < 3; ++k) {
+        RefinerExample e{p.in, p.in.latent, {}};
+        for (float& v : e.target) v -= float(k);
+        examples.push_back(e);
+    }
+    RefinerTrainOptions still = latent_training(400, 8);
+    still.lr = 0.f;
+    still.w_ssim = 0.f;
+    still.patience = 30;
+    auto r = Refiner::create(small(), 5);
+    const RefinerTrainResult res = r->train(examples, nullptr, nullptr, still);
+    int all_seen = -1;
+    std::vector<bool> seen(3, false);
+    for (const RefinerRecord& rec : res.history) {
+        seen[size_t(rec.example)] = true;
+        EXPECT_NEAR(rec.mse, double(rec.example * rec.example), 1e-6) << "iteration " << rec.iteration;
+        if (all_seen < 0 && seen[0] && seen[1] && seen[2]) all_seen = rec.iteration;
+        if (all_seen >= 0) {
+            EXPECT_NEAR(rec.smoothed, 5.0 / 3.0, 1e-6) << "iteration " << rec.iteration;
+        }
+    }
+    ASSERT_GE(all_seen, 0);
+    EXPECT_EQ(res.history.back().iteration, res.best_iteration + still.patience);  // stopped, not run out
+
+    // Resumed halfway, a learning run repeats the uninterrupted one's smoothed losses exactly.
+    RefinerTrainOptions o = latent_training(40, 8);
+    auto full = Refiner::create(small(), 6);
+    const RefinerTrainResult whole = full->train(examples, nullptr, nullptr, o);
+    o.checkpoint_path = temp_path("examples_ck.pt");
+    std::filesystem::remove(o.checkpoint_path);
+    o.checkpoint_every = 0;
+    o.iterations = 15;
+    auto part = Refiner::create(small(), 6);
+    part->train(examples, nullptr, nullptr, o);
+    o.iterations = 40;
+    o.resume = true;
+    auto resumed = Refiner::create(small(), 77);
+    const RefinerTrainResult rest = resumed->train(examples, nullptr, nullptr, o);
+    ASSERT_EQ(rest.history.size(), whole.history.size());
+    for (size_t i = 0; i < whole.history.size(); ++i) {
+        EXPECT_EQ(rest.history[i].smoothed, whole.history[i].smoothed) << "iteration " << i;
+        EXPECT_EQ(rest.history[i].example, whole.history[i].example) << "iteration " << i;
+    }
+    EXPECT_EQ(resumed->refine(p.in), full->refine(p.in));
+    examples.pop_back();  // another number of views cannot continue that checkpoint
+    EXPECT_THROW(resumed->train(examples, nullptr, nullptr, o), std::runtime_error);
+}
+
 // Cosine decay: step i uses lr · (1 + cos(π i / N)) / 2. Two runs of N = 2 steps from one start,
 // constant and decayed, take the same first step (lr) and then the same Adam direction from the
 // same weights, the decayed one at half the rate (cos(π/2) = 0), so its second step moves the
