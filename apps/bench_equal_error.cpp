@@ -94,19 +94,9 @@ int run_bench_equal_error(const BenchArgs& a) {
     std::printf("%-8s %6s %10s %10s %12s %12s\n", "method", "spp", "render s", "VAE s", "latent MSE", "RGB MSE");
     std::vector<Point> lat, rgb;
     // The warm-up render (thread pool, BVH caches) is not timed.
-    {
-        RenderOptions o = RenderOptions::from_scene(*fit.scene);
-        o.width = w;
-        o.height = h;
-        o.spp = 1;
-        render_toned(*fit.model, o, fit.tone);
-    }
+    render_toned(*fit.model, RenderOptions::from_scene(*fit.scene, w, h, 1, 0), fit.tone);
     for (int spp = 1; spp <= std::max(1, a.max_spp / 4); spp *= 2) {
-        RenderOptions o = RenderOptions::from_scene(*fit.scene);
-        o.width = w;
-        o.height = h;
-        o.spp = spp;
-        o.seed = seed;
+        RenderOptions o = RenderOptions::from_scene(*fit.scene, w, h, spp, seed);
         Point p;
         p.spp = spp;
         auto t0 = std::chrono::steady_clock::now();
@@ -123,11 +113,7 @@ int run_bench_equal_error(const BenchArgs& a) {
                     p.rgb_mse);
     }
     for (int spp = 1; spp <= a.max_spp; spp *= 2) {
-        RenderOptions o = RenderOptions::from_scene(*fit.scene);
-        o.width = W;
-        o.height = H;
-        o.spp = spp;
-        o.seed = seed;
+        RenderOptions o = RenderOptions::from_scene(*fit.scene, W, H, spp, seed);
         Point p;
         p.spp = spp;
         auto t0 = std::chrono::steady_clock::now();

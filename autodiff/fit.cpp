@@ -19,13 +19,9 @@ namespace lpt {
 namespace {
 
 RenderOptions iteration_options(const LatentModel& model, const FitOptions& o, int width, int height, int iteration) {
-    RenderOptions r = RenderOptions::from_scene(model.scene());
-    r.spp = o.spp;
-    r.width = width;
-    r.height = height;
     // A new, reproducible set of paths per iteration: resumed fits replay the same ones.
-    r.seed = mix64(o.seed * 0x9e3779b97f4a7c15ULL + uint64_t(iteration) + 1);
-    return r;
+    return RenderOptions::from_scene(model.scene(), width, height, o.spp,
+                                     mix64(o.seed * 0x9e3779b97f4a7c15ULL + uint64_t(iteration) + 1));
 }
 
 }  // namespace

@@ -34,6 +34,8 @@ struct RenderOptions {
     /// The scene's settings; the sampler is the command line's `--sampler` where one was given
     /// (set_sampler_override), else the scene's.
     static RenderOptions from_scene(const Scene& scene);
+    /// The same for an image of width × height (0: the camera's) at `spp` samples with `seed`.
+    static RenderOptions from_scene(const Scene& scene, int width, int height, int spp, uint64_t seed);
 };
 
 struct RenderStats {

@@ -22,4 +22,13 @@ RenderOptions RenderOptions::from_scene(const Scene& scene) {
     return o;
 }
 
+RenderOptions RenderOptions::from_scene(const Scene& scene, int width, int height, int spp, uint64_t seed) {
+    RenderOptions o = from_scene(scene);
+    o.width = width;
+    o.height = height;
+    o.spp = spp;
+    o.seed = seed;
+    return o;
+}
+
 }  // namespace lpt

@@ -66,11 +66,7 @@ Target synthetic_target(const FitJob& job, const Scene& scene) {
     Target t;
     parse_resolution(job.synthetic_res, t.width, t.height, "--synthetic-res");
     LatentModel truth(scene, parameterisation_from_string(job.param), job.synthetic_seed);
-    RenderOptions ro = RenderOptions::from_scene(scene);
-    ro.width = t.width;
-    ro.height = t.height;
-    ro.spp = job.final_spp;
-    ro.seed = job.synthetic_seed;
+    RenderOptions ro = RenderOptions::from_scene(scene, t.width, t.height, job.final_spp, job.synthetic_seed);
     t.data = render_toned(truth, ro, job.options.tone);
     return t;
 }
@@ -138,11 +134,7 @@ double write_stage1(const FitJob& job, const LatentModel& model, const Target& t
                     const Vae* vae) {
     const fs::path out(job.out);
     const int w = target.width, h = target.height;
-    RenderOptions ro = RenderOptions::from_scene(model.scene());
-    ro.width = w;
-    ro.height = h;
-    ro.spp = job.final_spp;
-    ro.seed = job.options.seed + 1;
+    RenderOptions ro = RenderOptions::from_scene(model.scene(), w, h, job.final_spp, job.options.seed + 1);
     TermFilms<kLatentChannels> films =
         render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro);
     std::vector<float> linear = films.sum(), toned(linear.size());

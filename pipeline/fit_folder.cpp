@@ -23,12 +23,7 @@ nlohmann::json parse_json_file(const std::string& path) {
 }  // namespace
 
 std::vector<float> render_fit_latent(const FitFolder& fit, int w, int h, int spp, uint64_t seed) {
-    RenderOptions ro = RenderOptions::from_scene(*fit.scene);
-    ro.width = w;
-    ro.height = h;
-    ro.spp = spp;
-    ro.seed = seed;
-    return render_toned(*fit.model, ro, fit.tone);
+    return render_toned(*fit.model, RenderOptions::from_scene(*fit.scene, w, h, spp, seed), fit.tone);
 }
 
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {

@@ -25,11 +25,7 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
         throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) +
                                     " in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
-    RenderOptions o = RenderOptions::from_scene(scene);
-    o.width = width;
-    o.height = height;
-    o.spp = spp;
-    o.seed = 0x5eed;
+    RenderOptions o = RenderOptions::from_scene(scene, width, height, spp, 0x5eed);
     RenderStats st;
     std::vector<float> rgb = render_path<3>(scene, spectra, o, &st).develop();
     for (float& v : rgb) v = display_value(v, tone);

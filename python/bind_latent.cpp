@@ -18,12 +18,7 @@ struct LatentScene {
     int width = 0, height = 0;  ///< the default latent resolution
 
     RenderOptions options(int w, int h, int spp, uint64_t seed) const {
-        RenderOptions o = RenderOptions::from_scene(*scene);
-        o.width = w > 0 ? w : width;
-        o.height = h > 0 ? h : height;
-        o.spp = spp;
-        o.seed = seed;
-        return o;
+        return RenderOptions::from_scene(*scene, w > 0 ? w : width, h > 0 ? h : height, spp, seed);
     }
     size_t floats(const RenderOptions& o) const { return size_t(o.width) * size_t(o.height) * kLatentChannels; }
     int slice(const std::string& name) const {

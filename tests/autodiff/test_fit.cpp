@@ -22,11 +22,7 @@ Scene cornell() {
 }
 
 RenderOptions target_options(const Scene& s, int spp, uint64_t seed) {
-    RenderOptions o = RenderOptions::from_scene(s);
-    o.spp = spp;
-    o.seed = seed;
-    o.width = o.height = kRes;
-    return o;
+    return RenderOptions::from_scene(s, kRes, kRes, spp, seed);
 }
 
 FitOptions fit_options(int iterations) {

@@ -496,10 +496,7 @@ TEST(Refiner, LossDecreasesOnATinyRenderedScene) {
         std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json",
         {{"camera.width", std::to_string(res)}, {"camera.height", std::to_string(res)}, {"integrator.max_depth", "3"}});
     LatentModel fitted(scene, Parameterisation::Code, 1), truth(scene, Parameterisation::Code, 2);
-    RenderOptions ro = RenderOptions::from_scene(scene);
-    ro.width = ro.height = res;
-    ro.spp = 16;
-    ro.seed = 3;
+    const RenderOptions ro = RenderOptions::from_scene(scene, res, res, 16, 3);
     const std::vector<float> latent = render_toned(fitted, ro, ToneCurve::Clip),
                              target = render_toned(truth, ro, ToneCurve::Clip);
     AovImages aov = render_aovs(scene, SceneSpectra<3>::from_description(scene), res, res, ro.spp, ro.seed);
