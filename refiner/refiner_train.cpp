@@ -42,19 +42,25 @@ void put_params(torch::nn::Module& net, const ParamCopy& c) {
 constexpr double kSmoothing = 0.98;  // EMA of the crop loss: crops differ, the smoothed loss decides
 
 /// The smoothed loss that early stopping and the best weights follow: an EMA of the crop loss per
-/// training example, averaged over the examples drawn so far. Examples differ in level (a rolled
-/// view, another noise pattern), so one EMA of the mixed losses jumps with the draw and stops
-/// training early; the mean of per-example EMAs does not depend on which example was drawn. With
-/// one example it is the plain EMA of the crop loss.
+/// training example, averaged over the examples. Examples differ in level (a rolled view, another
+/// noise pattern), so one EMA of the mixed losses jumps with the draw and stops training early;
+/// the mean of per-example EMAs does not depend on which example was drawn. Each example is drawn
+/// every K steps on average, so its EMA keeps kSmoothing^K per draw: the mean forgets at the rate
+/// of one EMA per step, whatever K. Until every example has been drawn the mean lacks some of them
+/// and says nothing (complete() is false). With one example it is the plain EMA of the crop loss.
 class ExampleSmoothing {
 public:
-    explicit ExampleSmoothing(size_t examples) : m_ema(examples, 0.0), m_seen(examples, false) {}
+    explicit ExampleSmoothing(size_t examples)
+        : m_ema(examples, 0.0),
+          m_seen(examples, false),
+          m_factor(examples == 1 ? kSmoothing : std::pow(kSmoothing, double(examples))) {}
 
     void update(int example, double loss) {
         double& e = m_ema[size_t(example)];
-        e = m_seen[size_t(example)] ? kSmoothing * e + (1 - kSmoothing) * loss : loss;
+        e = m_seen[size_t(example)] ? m_factor * e + (1 - m_factor) * loss : loss;
         m_seen[size_t(example)] = true;
     }
+    bool complete() const { return std::find(m_seen.begin(), m_seen.end(), false) == m_seen.end(); }
     double value() const {
         double sum = 0;
         int n = 0;
@@ -84,6 +90,7 @@ public:
 private:
     std::vector<double> m_ema;
     std::vector<bool> m_seen;
+    double m_factor;
 };
 
 /// Everything a training run carries from one iteration to the next, and its checkpoint.
@@ -354,9 +361,11 @@ RefinerTrainResult Refiner::train(const std::vector<RefinerExample>& examples, c
         r.smoothed = s.smoothed.value();
         r.seconds = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         s.result.history.push_back(r);
-        const bool should_stop = s.stop.update(r.smoothed, it);
-        if (s.stop.improved()) s.best = copy_params(*net);
-        if (o.patience > 0 && should_stop) stopped = true;
+        if (s.smoothed.complete()) {  // a mean over some of the examples is no measure of progress
+            const bool should_stop = s.stop.update(r.smoothed, it);
+            if (s.stop.improved()) s.best = copy_params(*net);
+            if (o.patience > 0 && should_stop) stopped = true;
+        }
         if (o.checkpoint_every > 0 && (it + 1) % o.checkpoint_every == 0)
             save_checkpoint(o.checkpoint_path, net, cfg, s);
         if (on_iteration && !on_iteration(r)) break;

@@ -215,8 +215,9 @@ TEST(Refiner, ExamplesBringTheirOwnTargetsAndSizes) {
 // Early stopping follows the mean over examples of each example's EMA of its crop loss, not one
 // EMA of the mixed losses, which jumps with the example drawn. With lr 0 example k (target =
 // latent − k) always scores k², so once all three are drawn the smoothed loss is (0 + 1 + 4) / 3
-// at every step, whichever example the step drew, and training stops `patience` steps after the
-// smoothed loss last fell. A resumed run restores every example's EMA.
+// at every step, whichever example the step drew. Early stopping counts from the step that drew
+// the last of them (a mean over some examples is no measure), so this run stops `patience` steps
+// after it. A resumed run restores every example's EMA.
 TEST(Refiner, TheSmoothedLossIsTheMeanOfEachExamplesEma) {
     Problem p = make_problem(12, 12);
     std::vector<RefinerExample> examples;
@@ -242,12 +243,28 @@ TEST(Refiner, TheSmoothedLossIsTheMeanOfEachExamplesEma) {
         }
     }
     ASSERT_GE(all_seen, 0);
-    EXPECT_EQ(res.history.back().iteration, res.best_iteration + still.patience);  // stopped, not run out
+    EXPECT_EQ(res.best_iteration, all_seen);  // no step before every example was drawn counts
+    EXPECT_EQ(res.history.back().iteration, all_seen + still.patience);
 
     // Resumed halfway, a learning run repeats the uninterrupted one's smoothed losses exactly.
     RefinerTrainOptions o = latent_training(40, 8);
     auto full = Refiner::create(small(), 6);
     const RefinerTrainResult whole = full->train(examples, nullptr, nullptr, o);
+    // Recomputed from the history: each example's EMA keeps 0.98^3 per draw (its memory in steps
+    // is one EMA's at 0.98), and the smoothed loss is their mean over the examples drawn so far.
+    const double keep = std::pow(0.98, 3.0);
+    std::vector<double> ema(3, 0.0);
+    std::vector<bool> drawn(3, false);
+    for (const RefinerRecord& rec : whole.history) {
+        double& e = ema[size_t(rec.example)];
+        e = drawn[size_t(rec.example)] ? keep * e + (1 - keep) * rec.loss : rec.loss;
+        drawn[size_t(rec.example)] = true;
+        double sum = 0;
+        int n = 0;
+        for (size_t k = 0; k < 3; ++k)
+            if (drawn[k]) sum += ema[k], ++n;
+        EXPECT_NEAR(rec.smoothed, sum / n, 1e-12) << "iteration " << rec.iteration;
+    }
     o.checkpoint_path = temp_path("examples_ck.pt");
     std::filesystem::remove(o.checkpoint_path);
     o.checkpoint_every = 0;
