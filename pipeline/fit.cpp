@@ -177,6 +177,7 @@ void validate(const FitJob& job) {
         throw std::invalid_argument("--gate is shadowed or visible, got '" + job.gate + "'");
     if (job.ref_tone != "clip" && job.ref_tone != "reinhard")
         throw std::invalid_argument("--ref-tone is clip or reinhard, got '" + job.ref_tone + "'");
+    if (job.refiner) validate(job.refine);
 }
 
 FitSummary run_fit(const FitJob& job, const Reporter& report) {

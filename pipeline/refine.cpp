@@ -11,6 +11,7 @@
 #include "vae/lpips.h"
 #include "vae/vae.h"
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -186,7 +187,34 @@ int inference_window(const RefineJob& job, const RefinerInput& in) {
 
 }  // namespace
 
+void validate(const RefineJob& job) {
+    auto require = [](bool ok, const char* option, const std::string& range, double value) {
+        if (!ok) {
+            char v[32];
+            std::snprintf(v, sizeof v, "%g", value);
+            throw std::invalid_argument(std::string("refine --") + option + " (fit --refiner-" + option + ") must be " +
+                                        range + ", got " + v);
+        }
+    };
+    const RefinerTrainOptions& t = job.train;
+    const RefinerConfig& n = job.net;
+    require(t.iterations > 0, "iterations", "> 0", t.iterations);
+    require(n.expansion > 0, "expansion", "> 0", n.expansion);
+    require(t.crop >= 0, "crop", ">= 0", t.crop);
+    require(t.lpips_crop >= 0, "lpips-crop", ">= 0", t.lpips_crop);
+    require(t.lr > 0 && std::isfinite(t.lr), "lr", "> 0", t.lr);
+    require(t.patience >= 0, "patience", ">= 0", t.patience);
+    require(t.w_mse >= 0, "w-mse", ">= 0", t.w_mse);
+    require(t.w_ssim >= 0, "w-ssim", ">= 0", t.w_ssim);
+    require(t.w_lpips >= 0, "w-lpips", ">= 0", t.w_lpips);
+    require(n.squash > 0 && std::isfinite(n.squash), "squash", "> 0", n.squash);
+    require(n.dropout >= 0 && n.dropout <= 0.99f, "dropout", "in [0, 0.99]", n.dropout);
+    require(job.noise_views > 0, "noise-views", "> 0", job.noise_views);
+    require(t.checkpoint_every >= 0, "checkpoint-every", ">= 0", t.checkpoint_every);
+}
+
 RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
+    validate(job);
     const fs::path dir(job.fitdir);
     if (!fs::is_directory(dir))
         throw std::runtime_error(job.fitdir + ": not a folder (expected a fit folder made by latentpt fit)");

@@ -34,6 +34,10 @@ struct RefineSummary {
     bool decoded = false;    ///< a VAE was found: decoded_refined.png written, RGB metrics present
 };
 
+/// Throws std::invalid_argument naming the option (as the CLI spells it) when a value is out of
+/// its range: the command line checks them as it parses, library and Python callers here.
+void validate(const RefineJob& job);
+
 /// Throws Cancelled when the reporter cancels (refiner_checkpoint.pt keeps the last checkpoint).
 RefineSummary run_refine(const RefineJob& job, const Reporter& report = {});
 

@@ -15,11 +15,15 @@ namespace lpt::python {
 namespace {
 
 /// Calls `progress(dict)` after every step (a falsy return cancels) and `note(str)` for notes;
-/// without a note callback notes go to Python's stderr.
-pipeline::Reporter reporter(const py::object& progress, const py::object& note) {
+/// without a note callback notes go to Python's stderr. The pipeline runs without the GIL (torch's
+/// autograd refuses to run while it is held, and other Python threads go on), so each callback
+/// takes it back; they hold borrowed handles, kept alive by the caller's arguments for the call.
+pipeline::Reporter reporter(const py::object& progress_object, const py::object& note_object) {
     pipeline::Reporter r;
+    const py::handle progress = progress_object, note = note_object;
     if (!progress.is_none())
         r.progress = [progress](const pipeline::StageProgress& p) {
+            py::gil_scoped_acquire gil;
             py::dict d;
             d["stage"] = p.stage;
             d["step"] = p.step;
@@ -31,16 +35,52 @@ pipeline::Reporter reporter(const py::object& progress, const py::object& note) 
             return keep.is_none() || keep.cast<bool>();
         };
     r.note = [note](const std::string& text) {
+        py::gil_scoped_acquire gil;
         if (note.is_none()) py::print(text, py::arg("file") = py::module_::import("sys").attr("stderr"));
         else note(text);
     };
     return r;
 }
 
-/// refiner_norm="instance" | "none", as --refiner-norm.
-bool norm_option(const std::string& v) {
-    if (v != "instance" && v != "none") throw py::value_error("fit(): refiner_norm must be 'instance' or 'none'");
-    return v == "instance";
+/// f() with the GIL released: the pipeline's long calls (see reporter()).
+template <class F>
+auto without_gil(F&& f) {
+    py::gil_scoped_release unlocked;
+    return f();
+}
+
+/// A string option that takes one of two words, as the CLI's: true for `yes`.
+bool either(const std::string& option, const std::string& v, const char* yes, const char* no) {
+    if (v != yes && v != no) throw py::value_error(option + " must be '" + yes + "' or '" + no + "', got '" + v + "'");
+    return v == yes;
+}
+
+/// Sets the RefineJob field that `key` names (refine --<key> with underscores, e.g. lr_decay);
+/// false when the key is not a refiner option. Ranges are checked by pipeline::validate.
+bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const py::handle& value) {
+    RefinerTrainOptions& t = job.train;
+    RefinerConfig& n = job.net;
+    if (k == "iterations") t.iterations = value.cast<int>();
+    else if (k == "expansion") n.expansion = value.cast<int>();
+    else if (k == "crop") t.crop = value.cast<int>();
+    else if (k == "lpips_crop") t.lpips_crop = value.cast<int>();
+    else if (k == "lr") t.lr = value.cast<float>();
+    else if (k == "lr_decay") t.cosine_decay = either(k, value.cast<std::string>(), "cosine", "none");
+    else if (k == "patience") t.patience = value.cast<int>();
+    else if (k == "w_mse") t.w_mse = value.cast<float>();
+    else if (k == "w_ssim") t.w_ssim = value.cast<float>();
+    else if (k == "w_lpips") t.w_lpips = value.cast<float>();
+    else if (k == "squash") n.squash = value.cast<float>();
+    else if (k == "norm") n.instance_norm = either(k, value.cast<std::string>(), "instance", "none");
+    else if (k == "inference") job.windowed_inference = either(k, value.cast<std::string>(), "windows", "whole");
+    else if (k == "dropout") n.dropout = value.cast<float>();
+    else if (k == "noise_views") job.noise_views = value.cast<int>();
+    else if (k == "augment") job.augment = pipeline::parse_refiner_augment(value.cast<std::string>());
+    else if (k == "checkpoint_every") t.checkpoint_every = value.cast<int>();
+    else if (k == "lpips_dir") job.lpips_dir = value.cast<std::string>();
+    else if (k == "seed") t.seed = value.cast<uint64_t>();
+    else return false;
+    return true;
 }
 
 /// Sets the job fields named in `options` (the CLI's option names with underscores).
@@ -69,10 +109,10 @@ void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
         else if (k == "terms") job.terms = value.cast<std::string>();
         else if (k == "resume") job.resume = value.cast<bool>();
         else if (k == "refiner") job.refiner = value.cast<bool>();
-        else if (k == "refiner_iterations") job.refine.train.iterations = value.cast<int>();
-        else if (k == "refiner_expansion") job.refine.net.expansion = value.cast<int>();
-        else if (k == "refiner_norm") job.refine.net.instance_norm = norm_option(value.cast<std::string>());
         else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
+        else if (k.rfind("refiner_", 0) == 0 && k != "refiner_seed" &&
+                 apply_refine_option(job.refine, k.substr(8), value))
+            continue;
         else throw py::type_error("fit() got an unknown option '" + k + "'");
     }
 }
@@ -85,7 +125,8 @@ py::dict run_fit(const std::string& scene, const std::string& out, const std::ma
     job.defines = defines;
     apply_fit_options(job, options);
     pipeline::validate(job);
-    const pipeline::FitSummary s = pipeline::run_fit(job, reporter(progress, note));
+    const pipeline::Reporter report = reporter(progress, note);
+    const pipeline::FitSummary s = without_gil([&] { return pipeline::run_fit(job, report); });
     py::dict d;
     d["latent_width"] = s.latent_width;
     d["latent_height"] = s.latent_height;
@@ -96,13 +137,17 @@ py::dict run_fit(const std::string& scene, const std::string& out, const std::ma
     return d;
 }
 
-py::dict run_refine(const std::string& fitdir, int iterations, bool resume, const py::object& progress,
-                    const py::object& note) {
+py::dict run_refine(const std::string& fitdir, bool resume, const py::object& progress, const py::object& note,
+                    const py::kwargs& options) {
     pipeline::RefineJob job;
     job.fitdir = fitdir;
-    job.train.iterations = iterations;
     job.resume = resume;
-    const pipeline::RefineSummary s = pipeline::run_refine(job, reporter(progress, note));
+    for (const auto& [key, value] : options) {
+        const std::string k = py::str(key);
+        if (!apply_refine_option(job, k, value)) throw py::type_error("refine() got an unknown option '" + k + "'");
+    }
+    const pipeline::Reporter report = reporter(progress, note);
+    const pipeline::RefineSummary s = without_gil([&] { return pipeline::run_refine(job, report); });
     return py::module_::import("json").attr("loads")(s.metrics.dump());
 }
 
@@ -115,7 +160,8 @@ int render_edits(const std::string& fitdir, const std::string& edits, const std:
     job.spp = spp;
     job.seed = seed;
     job.reference = reference;
-    return pipeline::render_edits(job, reporter(progress, note));
+    const pipeline::Reporter report = reporter(progress, note);
+    return without_gil([&] { return pipeline::render_edits(job, report); });
 }
 
 struct PyVae {
@@ -167,9 +213,10 @@ void bind_pipeline(py::module_& m) {
         py::arg("progress") = py::none(), py::arg("note") = py::none(),
         "Stage 1 (and stage 2 unless refiner=False) into the fit folder `out`; keyword options as the CLI's "
         "(iterations, spp, seed, lr, encode, encode_res, synthetic_res, param, gate, terms, refiner_iterations, ...).");
-    m.def("refine", &run_refine, py::arg("fitdir"), py::arg("iterations") = 3000, py::arg("resume") = false,
-          py::arg("progress") = py::none(), py::arg("note") = py::none(),
-          "Stage 2 on a fit folder; returns metrics.json.");
+    m.def("refine", &run_refine, py::arg("fitdir"), py::arg("resume") = false, py::arg("progress") = py::none(),
+          py::arg("note") = py::none(),
+          "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
+          "(iterations, lr, lr_decay, crop, patience, augment, noise_views, norm, inference, dropout, seed, ...).");
     m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("progress") = py::none(),
           py::arg("note") = py::none(),

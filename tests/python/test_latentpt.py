@@ -4,6 +4,7 @@ against finite differences, the pipeline with a progress callback and a cancel, 
 latentpt in one process. Run by ctest (python.module) with PYTHONPATH=<build>/python."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -216,6 +217,38 @@ class PipelineTest(unittest.TestCase):
 
 
 class OneProcessTest(unittest.TestCase):
+    def test_refine_takes_the_command_lines_options(self):
+        """refine(**options) trains as `latentpt refine --options` does: the same refiner.pt, byte for
+        byte. An unknown option is a TypeError, a value out of its range a ValueError naming it."""
+        with tempfile.TemporaryDirectory() as d:
+            fit = os.path.join(d, "fit")
+            latentpt.fit(BOX, fit, defines={"integrator.max_depth": "3"}, note=lambda t: None,
+                         synthetic_res="8x8", iterations=4, spp=2, final_spp=4, refiner=False)
+            cli = os.path.join(d, "cli")
+            shutil.copytree(fit, cli)
+            latentpt.refine(fit, note=lambda t: None, iterations=7, crop=6, lr=2e-3, lr_decay="cosine",
+                            dropout=0.0, expansion=2, patience=0, seed=5)
+            with open(os.path.join(fit, "refiner_loss.csv")) as f:
+                self.assertEqual(len(f.readlines()), 1 + 7)
+            binary = os.environ.get("LATENTPT_BIN")
+            if binary:
+                subprocess.run([binary, "refine", cli, "-q", "--iterations", "7", "--crop", "6", "--lr", "0.002",
+                                "--lr-decay", "cosine", "--dropout", "0", "--expansion", "2", "--patience", "0",
+                                "--seed", "5"], check=True, stdout=subprocess.DEVNULL)
+                with open(os.path.join(fit, "refiner.pt"), "rb") as a, open(os.path.join(cli, "refiner.pt"), "rb") as b:
+                    self.assertEqual(a.read(), b.read())
+            with self.assertRaises(TypeError):
+                latentpt.refine(fit, crops=4)
+            for bad, name in (({"dropout": 1.5}, "dropout"), ({"lr_decay": "linear"}, "lr_decay"),
+                              ({"iterations": 0}, "iterations"), ({"augment": "turn"}, "turn")):
+                with self.assertRaises(ValueError) as e:
+                    latentpt.refine(fit, note=lambda t: None, **bad)
+                self.assertIn(name, str(e.exception))
+            with self.assertRaises(ValueError) as e:  # fit() checks its refiner options before it starts
+                latentpt.fit(BOX, os.path.join(d, "fit2"), synthetic_res="8x8", refiner_dropout=2.0)
+            self.assertIn("dropout", str(e.exception))
+            self.assertFalse(os.path.exists(os.path.join(d, "fit2")))
+
     def test_torch_and_latentpt_load_together_in_either_order(self):
         torch_or_skip()
         for first, second in (("torch", "latentpt"), ("latentpt", "torch")):
