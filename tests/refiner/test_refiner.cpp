@@ -77,6 +77,27 @@ RefinerTrainOptions latent_training(int iterations, int crop) {
     return o;
 }
 
+/// Training that never moves the weights (lr 0, latent MSE alone): the network stays the
+/// identity, so a step's loss shows which view or example it drew.
+RefinerTrainOptions still_training(int iterations, int crop) {
+    RefinerTrainOptions o = latent_training(iterations, crop);
+    o.lr = 0.f;
+    o.w_ssim = 0.f;
+    return o;
+}
+
+/// Example k of the result is sources[k]'s view with target = its latent − k: under
+/// still_training it scores latent MSE k².
+std::vector<RefinerExample> offset_examples(const std::vector<const Problem*>& sources) {
+    std::vector<RefinerExample> examples;
+    for (size_t k = 0; k < sources.size(); ++k) {
+        RefinerExample e{sources[k]->in, sources[k]->in.latent, {}};
+        for (float& v : e.target) v -= float(k);
+        examples.push_back(e);
+    }
+    return examples;
+}
+
 /// The window [x0, x0 + w) × [y0, y0 + h) of a view.
 RefinerInput crop_of(const RefinerInput& in, int x0, int y0, int w, int h) {
     RefinerInput c;
@@ -167,9 +188,7 @@ TEST(Refiner, NoiseViewsAreDrawnEvenlyAndOneViewTrainsAsBefore) {
     std::vector<RefinerInput> views(3, p.in);
     for (int k = 0; k < 3; ++k)
         for (size_t i = 0; i < p.in.latent.size(); ++i) views[size_t(k)].latent[i] = p.target[i] + float(k);
-    RefinerTrainOptions still = latent_training(150, 8);
-    still.lr = 0.f;
-    still.w_ssim = 0.f;
+    const RefinerTrainOptions still = still_training(150, 8);
     auto r = Refiner::create(cfg, 5);
     const RefinerTrainResult res = r->train(views, p.target, nullptr, nullptr, nullptr, still);
     expect_offsets_drawn_evenly(res, 3);
@@ -193,16 +212,8 @@ TEST(Refiner, ExamplesBringTheirOwnTargetsAndSizes) {
     one->train(std::vector<RefinerExample>{{p.in, p.target, {}}}, nullptr, nullptr, o);
     EXPECT_EQ(single->refine(p.in), one->refine(p.in));
 
-    std::vector<RefinerExample> examples;
-    for (int k = 0; k < 3; ++k) {
-        const Problem& src = k == 1 ? q : p;
-        RefinerExample e{src.in, src.in.latent, {}};
-        for (float& v : e.target) v -= float(k);
-        examples.push_back(e);
-    }
-    RefinerTrainOptions still = latent_training(150, 14);
-    still.lr = 0.f;
-    still.w_ssim = 0.f;
+    std::vector<RefinerExample> examples = offset_examples({&p, &q, &p});
+    const RefinerTrainOptions still = still_training(150, 14);
     auto r = Refiner::create(cfg, 5);
     const RefinerTrainResult res = r->train(examples, nullptr, nullptr, still);
     expect_offsets_drawn_evenly(res, 3);
@@ -220,15 +231,8 @@ TEST(Refiner, ExamplesBringTheirOwnTargetsAndSizes) {
 // after it. A resumed run restores every example's EMA.
 TEST(Refiner, TheSmoothedLossIsTheMeanOfEachExamplesEma) {
     Problem p = make_problem(12, 12);
-    std::vector<RefinerExample> examples;
-    for (int k = 0; k < 3; ++k) {
-        RefinerExample e{p.in, p.in.latent, {}};
-        for (float& v : e.target) v -= float(k);
-        examples.push_back(e);
-    }
-    RefinerTrainOptions still = latent_training(400, 8);
-    still.lr = 0.f;
-    still.w_ssim = 0.f;
+    std::vector<RefinerExample> examples = offset_examples({&p, &p, &p});
+    RefinerTrainOptions still = still_training(400, 8);
     still.patience = 30;
     auto r = Refiner::create(small(), 5);
     const RefinerTrainResult res = r->train(examples, nullptr, nullptr, still);
