@@ -257,8 +257,9 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     if (examples.size() > 1 && o.patience > 0)
         report.say("note: " + std::to_string(examples.size()) + " training views with early stopping (patience " +
                    std::to_string(o.patience) +
-                   "): the crop loss jumps between the views, which can stop training long before its schedule "
-                   "ends; patience 0 (fit --refiner-patience 0, refine --patience 0) runs every step (docs/refiner.md "
+                   "): the smoothed loss of several views improves more slowly than its noise late in the "
+                   "schedule, which stopped such runs at ~70 % of their steps; patience 0 (fit --refiner-patience 0, "
+                   "refine --patience 0) runs every step (docs/refiner.md "
                    "\"Augmentation\")");
     s.result = refiner->train(examples, judges.vae.get(), judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");

@@ -70,8 +70,6 @@ struct RefinerTrainOptions {
 
 struct RefinerRecord {
     int iteration = 0;
-    int example = 0;  ///< which training example the crop came from
-    /// smoothed: the mean over the examples drawn so far of each one's EMA of its crop loss.
     double loss = 0, smoothed = 0, mse = 0, dssim = 0, lpips = 0, seconds = 0;
     /// The loss or a weight's gradient was not finite: the step was refused, weights and Adam
     /// state kept. refused_parameter names the weight ("loss" when the loss itself was bad).

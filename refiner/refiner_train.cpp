@@ -41,58 +41,6 @@ void put_params(torch::nn::Module& net, const ParamCopy& c) {
 
 constexpr double kSmoothing = 0.98;  // EMA of the crop loss: crops differ, the smoothed loss decides
 
-/// The smoothed loss that early stopping and the best weights follow: an EMA of the crop loss per
-/// training example, averaged over the examples. Examples differ in level (a rolled view, another
-/// noise pattern), so one EMA of the mixed losses jumps with the draw and stops training early;
-/// the mean of per-example EMAs does not depend on which example was drawn. Each example is drawn
-/// every K steps on average, so its EMA keeps kSmoothing^K per draw: the mean forgets at the rate
-/// of one EMA per step, whatever K. Until every example has been drawn the mean lacks some of them
-/// and says nothing (complete() is false). With one example it is the plain EMA of the crop loss.
-class ExampleSmoothing {
-public:
-    explicit ExampleSmoothing(size_t examples)
-        : m_ema(examples, 0.0),
-          m_seen(examples, false),
-          m_factor(examples == 1 ? kSmoothing : std::pow(kSmoothing, double(examples))) {}
-
-    void update(int example, double loss) {
-        double& e = m_ema[size_t(example)];
-        e = m_seen[size_t(example)] ? m_factor * e + (1 - m_factor) * loss : loss;
-        m_seen[size_t(example)] = true;
-    }
-    bool complete() const { return std::find(m_seen.begin(), m_seen.end(), false) == m_seen.end(); }
-    double value() const {
-        double sum = 0;
-        int n = 0;
-        for (size_t i = 0; i < m_ema.size(); ++i)
-            if (m_seen[i]) sum += m_ema[i], ++n;
-        return n ? sum / n : 0.0;
-    }
-    /// Per-example EMAs for a checkpoint (unseen examples: NaN).
-    std::vector<double> save() const {
-        std::vector<double> v(m_ema.size(), std::numeric_limits<double>::quiet_NaN());
-        for (size_t i = 0; i < v.size(); ++i)
-            if (m_seen[i]) v[i] = m_ema[i];
-        return v;
-    }
-    void restore(const std::vector<double>& v) {
-        for (size_t i = 0; i < v.size(); ++i) {
-            m_seen[i] = !std::isnan(v[i]);
-            m_ema[i] = m_seen[i] ? v[i] : 0.0;
-        }
-    }
-    /// A checkpoint from before per-example EMAs holds only the mean: every example starts there.
-    void restore_all(double smoothed) {
-        std::fill(m_ema.begin(), m_ema.end(), smoothed);
-        std::fill(m_seen.begin(), m_seen.end(), true);
-    }
-
-private:
-    std::vector<double> m_ema;
-    std::vector<bool> m_seen;
-    double m_factor;
-};
-
 /// Everything a training run carries from one iteration to the next, and its checkpoint.
 struct TrainingState {
     torch::optim::Adam adam;
@@ -100,13 +48,12 @@ struct TrainingState {
     EarlyStopping stop;
     ParamCopy best;
     int start = 0;
-    ExampleSmoothing smoothed;
+    double smoothed = 0;
 
-    TrainingState(RefinerNet& net, const RefinerTrainOptions& o, size_t examples)
+    TrainingState(RefinerNet& net, const RefinerTrainOptions& o)
         : adam(net->parameters(), torch::optim::AdamOptions(o.lr)),
           stop(std::max(1, o.patience), o.min_delta),
-          best(copy_params(*net)),
-          smoothed(examples) {}
+          best(copy_params(*net)) {}
 };
 
 /// A checkpoint of another network shape cannot continue: say which option differs instead of
@@ -122,11 +69,9 @@ void check_checkpoint_network(const std::string& path, torch::serialize::InputAr
                                  "; resume with the same --expansion");
 }
 
-void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, size_t examples,
-                     TrainingState& s) {
+void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConfig& cfg, TrainingState& s) {
     if (path.empty() || !std::filesystem::exists(path))
         throw std::runtime_error("refiner: --resume but no checkpoint at '" + path + "'");
-    std::vector<double> smoothed_views;  // per-example EMAs; absent in checkpoints of one EMA
     try {
         torch::serialize::InputArchive ar, net_ar, best_ar, adam_ar;
         ar.load_from(path);
@@ -144,39 +89,25 @@ void load_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
         torch::Tensor hist;
         ar.read("history", hist);
         for (int64_t i = 0; i < hist.size(0); ++i) {
-            auto row = hist[i];
-            RefinerRecord r;
-            r.iteration = int(row[0].item<double>());
-            r.loss = row[1].item<double>();
-            r.smoothed = row[2].item<double>();
-            r.mse = row[3].item<double>();
-            r.dssim = row[4].item<double>();
-            r.lpips = row[5].item<double>();
-            r.seconds = row[6].item<double>();
-            if (hist.size(1) > 7) r.example = int(row[7].item<double>());  // older checkpoints: one view
-            s.result.history.push_back(r);
+            auto r = hist[i];
+            s.result.history.push_back({int(r[0].item<double>()),
+                                        r[1].item<double>(),
+                                        r[2].item<double>(),
+                                        r[3].item<double>(),
+                                        r[4].item<double>(),
+                                        r[5].item<double>(),
+                                        r[6].item<double>(),
+                                        false,
+                                        {}});
         }
         torch::Tensor st;
         ar.read("stop", st);
         s.stop.restore(st[0].item<double>(), int(st[1].item<double>()), int(st[2].item<double>()));
-        torch::Tensor views;
-        if (ar.try_read("smoothed_views", views)) {
-            smoothed_views.resize(size_t(views.size(0)));
-            for (size_t i = 0; i < smoothed_views.size(); ++i) smoothed_views[i] = views[int64_t(i)].item<double>();
-        }
     } catch (const c10::Error& e) {
         throw std::runtime_error(path + ": cannot read refiner checkpoint: " + e.what_without_backtrace());
     }
     s.start = s.result.history.empty() ? 0 : s.result.history.back().iteration + 1;
-    if (!smoothed_views.empty()) {
-        if (smoothed_views.size() != examples)
-            throw std::runtime_error(path + ": the checkpoint was trained on " + std::to_string(smoothed_views.size()) +
-                                     " views, this run has " + std::to_string(examples) +
-                                     "; resume with the same --noise-views and --augment");
-        s.smoothed.restore(smoothed_views);
-    } else if (!s.result.history.empty()) {
-        s.smoothed.restore_all(s.result.history.back().smoothed);
-    }
+    s.smoothed = s.result.history.empty() ? 0 : s.result.history.back().smoothed;
 }
 
 /// Written to a temporary file and renamed: a killed run never leaves half a checkpoint.
@@ -193,17 +124,15 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
     ar.write("best", best_ar);
     s.adam.save(adam_ar);
     ar.write("adam", adam_ar);
-    torch::Tensor hist = torch::zeros({int64_t(s.result.history.size()), 8}, torch::kFloat64);
+    torch::Tensor hist = torch::zeros({int64_t(s.result.history.size()), 7}, torch::kFloat64);
     for (size_t i = 0; i < s.result.history.size(); ++i) {
         const RefinerRecord& r = s.result.history[i];
-        const double v[8] = {double(r.iteration), r.loss,           r.smoothed, r.mse, r.dssim, r.lpips,
-                             r.seconds,           double(r.example)};
-        for (int k = 0; k < 8; ++k) hist[int64_t(i)][k] = v[k];
+        const double v[7] = {double(r.iteration), r.loss, r.smoothed, r.mse, r.dssim, r.lpips, r.seconds};
+        for (int k = 0; k < 7; ++k) hist[int64_t(i)][k] = v[k];
     }
     ar.write("history", hist);
     ar.write("stop", torch::tensor({s.stop.best_loss(), double(s.stop.best_iteration()), double(s.stop.bad_updates())},
                                    torch::kFloat64));
-    ar.write("smoothed_views", torch::tensor(s.smoothed.save(), torch::kFloat64));
     const std::string tmp_path = path + ".tmp";
     ar.save_to(tmp_path);
     std::filesystem::rename(tmp_path, path);
@@ -261,7 +190,6 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
     const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
     torch::manual_seed(key);                               // dropout masks
     const int view = pick(key + 5, int(d.xs.size()) - 1);  // 0 without drawing when there is one example
-    r.example = view;
     const torch::Tensor& x_view = d.xs[size_t(view)];
     const int w = int(x_view.size(3)), h = int(x_view.size(2));
     const int crop_w = crop_side(d.crop, w), crop_h = crop_side(d.crop, h);
@@ -340,8 +268,8 @@ RefinerTrainResult Refiner::train(const std::vector<RefinerExample>& examples, c
     RefinerNet& net = m->net;
     const RefinerConfig& cfg = m->config;
     const TrainingData data = training_data(examples, cfg, vae, lpips, o);
-    TrainingState s(net, o, examples.size());
-    if (o.resume) load_checkpoint(o.checkpoint_path, net, cfg, examples.size(), s);
+    TrainingState s(net, o);
+    if (o.resume) load_checkpoint(o.checkpoint_path, net, cfg, s);
     const double seconds_before = s.result.history.empty() ? 0.0 : s.result.history.back().seconds;
     const auto t0 = std::chrono::steady_clock::now();
     bool stopped = o.patience > 0 && s.stop.bad_updates() >= o.patience;
@@ -356,16 +284,14 @@ RefinerTrainResult Refiner::train(const std::vector<RefinerExample>& examples, c
         if (!r.refused) {
             if (o.cosine_decay) set_learning_rate(s.adam, decay.lr_at(it));
             s.adam.step();
-            s.smoothed.update(r.example, r.loss);
+            s.smoothed = it == 0 ? r.loss : kSmoothing * s.smoothed + (1 - kSmoothing) * r.loss;
         }
-        r.smoothed = s.smoothed.value();
+        r.smoothed = s.smoothed;
         r.seconds = seconds_before + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         s.result.history.push_back(r);
-        if (s.smoothed.complete()) {  // a mean over some of the examples is no measure of progress
-            const bool should_stop = s.stop.update(r.smoothed, it);
-            if (s.stop.improved()) s.best = copy_params(*net);
-            if (o.patience > 0 && should_stop) stopped = true;
-        }
+        const bool should_stop = s.stop.update(s.smoothed, it);
+        if (s.stop.improved()) s.best = copy_params(*net);
+        if (o.patience > 0 && should_stop) stopped = true;
         if (o.checkpoint_every > 0 && (it + 1) % o.checkpoint_every == 0)
             save_checkpoint(o.checkpoint_path, net, cfg, s);
         if (on_iteration && !on_iteration(r)) break;

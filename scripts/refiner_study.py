@@ -102,8 +102,13 @@ VARIANTS = {
                                     MSE + ["--lr-decay", "cosine", "--dropout", "0.2"], False, 6000),
     "mse_6000_cosine_expansion_8": ("mse_6000_cosine at half the width (expansion 8: 128 channels)",
                                     MSE + ["--lr-decay", "cosine", "--expansion", "8"], False, 6000),
-    # Early stopping on the mean of per-view EMAs (since 2026-11-26, session 12) instead of one EMA
-    # of the mixed crop losses: the same options as mse_6000_cosine_dihedral, which stopped at 4251.
+    # Whole-view training (InstanceNorm sees the statistics it sees at inference; no crops): a
+    # 128² step costs ~16 crop steps, so 750 steps are twice the preset's pixels.
+    "mse_750_cosine_whole_view": ("latent MSE on the whole view (no crops), 750 steps, lr falling along a half "
+                                  "cosine: twice the pixels of mse_6000_cosine's 32² crops",
+                                  MSE + ["--crop", "0", "--lr-decay", "cosine"], False, 750),
+    # Run with a binary whose early stopping followed the mean of per-view EMAs (session 12, not
+    # kept: it stopped at 4199 where mse_6000_cosine_dihedral, the same options, stopped at 4251).
     "mse_6000_cosine_dihedral_per_view": ("mse_6000_cosine_dihedral with early stopping on the mean of per-view EMAs",
                                           MSE + ["--lr-decay", "cosine", "--augment", "dihedral"], False, 6000),
     "mse_9000_cosine": ("latent MSE alone for 9000 iterations, lr falling along a half cosine to 0",
