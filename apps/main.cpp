@@ -130,7 +130,6 @@ struct Cli {
              *decode = nullptr, *viz = nullptr, *metrics = nullptr, *compare = nullptr;
 
     void add_render(CLI::App& app) {
-        std::vector<std::string> defines;
         render = app.add_subcommand("render", "path trace a scene (.json) to a float EXR plus an sRGB PNG preview");
         render->add_option("scene", r.scene, "scene file (.json or Mitsuba 3 .xml), or a fit folder with --edit")
             ->required()

@@ -18,6 +18,15 @@ scene="$src/scenes/cornell-box/scene.json"
 "$bin" render "$scene" --spp 2 --res 24x16 --aov --aov-res 6x4 -q --out "$out/r.exr"
 check test -s "$out/r.exr"; check test -s "$out/r.png"; check test -s "$out/r.normal.exr"
 
+# -D overrides a scene value as the dedicated flag does: the same pixels (render -D crashed from
+# 2026-11-25 to 11-26: its option was bound to a local that was gone by parse time).
+"$bin" render "$scene" --spp 2 --res 16x16 -q -D integrator.max_depth=2 --out "$out/define.exr"
+"$bin" render "$scene" --spp 2 --res 16x16 -q --max-depth 2 --out "$out/flag.exr"
+"$bin" render "$scene" --spp 2 --res 16x16 -q --out "$out/nodefine.exr"
+check cmp -s "$out/define.exr" "$out/flag.exr"
+check sh -c "! cmp -s '$out/define.exr' '$out/nodefine.exr'"
+expect_error "key=value" "$bin" render "$scene" -q -D integrator.max_depth --out "$out/x.exr"
+
 # Equal-noise bench end to end at toy size against a 64-spp reference, and its missing-reference error.
 "$bin" render "$scene" --spp 64 --res 16x16 -q --out "$out/noise_ref.exr"
 check sh -c "'$bin' bench --equal-noise --scene '$scene' --reference '$out/noise_ref.exr' --res 16 --seeds 1 --target-spp 4 --json '$out/noise.json' 2>/dev/null | grep -q 'sobol: .* fewer spp'"
