@@ -905,13 +905,34 @@ def make_cube():
     return np.array(P, dtype=np.float64), np.array(tris), None, np.array(uvs)
 
 
-SPHERE_SEGMENTS = (512, 256)  # (around, pole to pole)
+SPHERE_SEGMENTS = (512, 256)  # (around, pole to pole): fine, for mirrors and glass
+# Cycles 3.4 loses light from meshes of many small emitting triangles: a sphere light of radius
+# 0.4 over a plane read, against the closed form E = pi L r^2 cos / d^2 (ratios after each
+# polyhedron's own area deficit), -0.01 % as 64x32 segments, -0.04 % as 128x64 and -0.39 % as
+# 512x256 (docs/validation.md, "dining-room's last offset"). Emitting spheres: 128x64, pushed
+# out to the sphere's area. (Not every sphere: the coarser facets under smooth normals cost a
+# glass sphere in a furnace 3 % at its silhouette.)
+EMITTER_SPHERE_SEGMENTS = (128, 64)
 
 
-def make_sphere():
-    """Unit UV sphere with exact radial per-corner normals. Mitsuba's uv = (phi/2pi, theta/pi)
-    with phi = atan2(y, x), theta = acos(z); Blender v = 1 - v_mitsuba."""
-    nu, nv = SPHERE_SEGMENTS
+def uv_sphere_area_scale(nu, nv):
+    """Radius factor that gives the inscribed UV polyhedron the sphere's area (and so, by Cauchy's
+    formula, its mean projected area: what a light's power and far irradiance depend on)."""
+    th = np.linspace(0, math.pi, nv + 1)
+    ph = np.linspace(0, 2 * math.pi, nu + 1)
+    T, Ph = np.meshgrid(th, ph, indexing="ij")
+    P = np.stack([np.sin(T) * np.cos(Ph), np.sin(T) * np.sin(Ph), np.cos(T)], axis=-1)
+    a, b, c, d = P[:-1, :-1], P[:-1, 1:], P[1:, 1:], P[1:, :-1]
+    area = 0.5 * (np.linalg.norm(np.cross(d - a, c - a), axis=-1).sum() +
+                  np.linalg.norm(np.cross(c - a, b - a), axis=-1).sum())
+    return math.sqrt(4 * math.pi / area)
+
+
+def make_sphere(segments=SPHERE_SEGMENTS, match_area=False):
+    """Unit UV sphere with exact radial per-corner normals; with match_area its vertices are pushed
+    out by uv_sphere_area_scale. Mitsuba's uv = (phi/2pi, theta/pi) with phi = atan2(y, x),
+    theta = acos(z); Blender v = 1 - v_mitsuba."""
+    nu, nv = segments
     th = np.linspace(0, math.pi, nv + 1)
     ph = np.linspace(0, 2 * math.pi, nu + 1)
     T, Ph = np.meshgrid(th, ph, indexing="ij")  # (nv+1, nu+1), seam column duplicated
@@ -930,7 +951,7 @@ def make_sphere():
     uv_m = np.stack([Ph.ravel() / (2 * math.pi), T.ravel() / math.pi], axis=1)
     uv = np.stack([uv_m[:, 0], 1 - uv_m[:, 1]], axis=1)[tris]
     normals = P[tris]  # unit sphere: the normal is the position
-    return P, tris, normals, uv
+    return P * (uv_sphere_area_scale(nu, nv) if match_area else 1.0), tris, normals, uv
 
 
 # --------------------------------------------------------------------------------------------
@@ -1332,11 +1353,21 @@ class Loader:
             sv = np.linalg.svd(full_m[:3, :3], compute_uv=False)
             if sv.max() - sv.min() > 1e-5 * sv.max():
                 p.fail("a sphere's to_world must not scale anisotropically or shear", "to_world")
-            P, tris, normals, uvs = make_sphere()
+            if any(ch.tag == "emitter" for ch in p.children):
+                segs = EMITTER_SPHERE_SEGMENTS
+                P, tris, normals, uvs = make_sphere(segs, match_area=True)
+                scale = uv_sphere_area_scale(*segs)
+                approximation("emitting sphere shapes are tessellated: %dx%d-segment UV sphere with exact "
+                              "radial vertex normals, vertices at %.5f x radius so that its area is the "
+                              "sphere's (faces within %.1e x radius of the true sphere; finer meshes lose "
+                              "emitted light in Cycles 3.4)"
+                              % (segs + (scale, max(scale - 1, 1 - scale * math.cos(math.pi / segs[1])))))
+            else:
+                P, tris, normals, uvs = make_sphere()
+                approximation("sphere shapes are tessellated: %dx%d-segment UV sphere with exact radial "
+                              "vertex normals (max distance to the true sphere %.1e x radius)"
+                              % (SPHERE_SEGMENTS + (1 - math.cos(math.pi / SPHERE_SEGMENTS[1]),)))
             mesh = finalize_mesh(P, tris, normals, uvs, full_m, flip, where)
-            approximation("sphere shapes are tessellated: %dx%d-segment UV sphere with exact radial "
-                          "vertex normals (max distance to the true sphere %.1e x radius)"
-                          % (SPHERE_SEGMENTS + (1 - math.cos(math.pi / SPHERE_SEGMENTS[1]),)))
             source = "sphere"
         else:
             p.fail("shape '%s' is not supported (obj, ply, rectangle, cube, sphere)" % t)
