@@ -243,9 +243,9 @@ struct Cli {
             ->capture_default_str()
             ->check(positive());
         fit->add_option("--patience", f.job.options.patience,
-                        "early stopping: iterations without improvement of the smoothed "
-                        "loss->check(non_negative()); 0 = off")
-            ->capture_default_str();
+                        "early stopping: iterations without improvement of the smoothed loss; 0 = off")
+            ->capture_default_str()
+            ->check(non_negative());
         fit->add_option("--min-delta", f.job.options.min_delta, "early stopping: smallest improvement that counts")
             ->capture_default_str()
             ->check(non_negative());
@@ -264,8 +264,9 @@ struct Cli {
         fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")
             ->capture_default_str();
         fit->add_option("--checkpoint-every", f.job.options.checkpoint_every,
-                        "iterations between checkpoints->check(non_negative()); 0 = only at the end")
-            ->capture_default_str();
+                        "iterations between checkpoints; 0 = only at the end")
+            ->capture_default_str()
+            ->check(non_negative());
         fit->add_option("--reuse-paths", f.job.options.reuse_paths,
                         "K: trace and store one frame of paths every K iterations and replay them in between (no rays; "
                         "~56 bytes per path event, "

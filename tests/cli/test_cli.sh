@@ -87,6 +87,8 @@ expect_error "nope.obj" "$bin" render "$out/s.json" -q --out "$out/x.exr"
 expect_error "WxH" "$bin" render "$scene" --res 12 -q --out "$out/x.exr"
 # Out-of-range values are errors, not silently something else; a film too large fails with its size.
 expect_error "must be >= 0, got -1" "$bin" render "$scene" --spp -1 -q --out "$out/x.exr"
+expect_error "patience" "$bin" fit "$scene" --synthetic-res 8x8 --patience -1 -q --out "$out/x_fit"
+expect_error "checkpoint-every" "$bin" fit "$scene" --synthetic-res 8x8 --checkpoint-every -1 -q --out "$out/x_fit"
 expect_error "must be > 0, got 0" "$bin" --threads 0 render "$scene" -q --out "$out/x.exr"
 expect_error "must be > 0" "$bin" fit "$scene" --iterations 0 -q --out "$out/bad"
 expect_error "GiB" "$bin" render "$scene" --res 100000x100000 -q --out "$out/x.exr"
