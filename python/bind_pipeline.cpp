@@ -56,8 +56,11 @@ bool either(const std::string& option, const std::string& v, const char* yes, co
 }
 
 /// Sets the RefineJob field that `key` names (refine --<key> with underscores, e.g. lr_decay);
-/// false when the key is not a refiner option. Ranges are checked by pipeline::validate.
-bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const py::handle& value) {
+/// false when the key is not a refiner option. Ranges are checked by pipeline::validate; errors
+/// name the option as the caller spelled it (`prefix` + key: fit's refiner_norm).
+bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const py::handle& value,
+                         const std::string& prefix = "") {
+    const std::string shown = prefix + k;
     RefinerTrainOptions& t = job.train;
     RefinerConfig& n = job.net;
     if (k == "iterations") t.iterations = value.cast<int>();
@@ -65,14 +68,14 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "crop") t.crop = value.cast<int>();
     else if (k == "lpips_crop") t.lpips_crop = value.cast<int>();
     else if (k == "lr") t.lr = value.cast<float>();
-    else if (k == "lr_decay") t.cosine_decay = either(k, value.cast<std::string>(), "cosine", "none");
+    else if (k == "lr_decay") t.cosine_decay = either(shown, value.cast<std::string>(), "cosine", "none");
     else if (k == "patience") t.patience = value.cast<int>();
     else if (k == "w_mse") t.w_mse = value.cast<float>();
     else if (k == "w_ssim") t.w_ssim = value.cast<float>();
     else if (k == "w_lpips") t.w_lpips = value.cast<float>();
     else if (k == "squash") n.squash = value.cast<float>();
-    else if (k == "norm") n.instance_norm = either(k, value.cast<std::string>(), "instance", "none");
-    else if (k == "inference") job.windowed_inference = either(k, value.cast<std::string>(), "windows", "whole");
+    else if (k == "norm") n.instance_norm = either(shown, value.cast<std::string>(), "instance", "none");
+    else if (k == "inference") job.windowed_inference = either(shown, value.cast<std::string>(), "windows", "whole");
     else if (k == "dropout") n.dropout = value.cast<float>();
     else if (k == "noise_views") job.noise_views = value.cast<int>();
     else if (k == "augment") job.augment = pipeline::parse_refiner_augment(value.cast<std::string>());
@@ -110,8 +113,9 @@ void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
         else if (k == "resume") job.resume = value.cast<bool>();
         else if (k == "refiner") job.refiner = value.cast<bool>();
         else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
+        else if (k == "lpips_dir") job.refine.lpips_dir = value.cast<std::string>();  // fit --lpips-dir
         else if (k.rfind("refiner_", 0) == 0 && k != "refiner_seed" &&
-                 apply_refine_option(job.refine, k.substr(8), value))
+                 apply_refine_option(job.refine, k.substr(8), value, "refiner_"))
             continue;
         else throw py::type_error("fit() got an unknown option '" + k + "'");
     }

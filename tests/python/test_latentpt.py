@@ -244,6 +244,9 @@ class OneProcessTest(unittest.TestCase):
                 with self.assertRaises(ValueError) as e:
                     latentpt.refine(fit, note=lambda t: None, **bad)
                 self.assertIn(name, str(e.exception))
+            with self.assertRaises(ValueError) as e:  # named as fit() spells it
+                latentpt.fit(BOX, os.path.join(d, "fit2"), synthetic_res="8x8", refiner_norm="batch")
+            self.assertIn("refiner_norm", str(e.exception))
             with self.assertRaises(ValueError) as e:  # fit() checks its refiner options before it starts
                 latentpt.fit(BOX, os.path.join(d, "fit2"), synthetic_res="8x8", refiner_dropout=2.0)
             self.assertIn("dropout", str(e.exception))
