@@ -915,22 +915,10 @@ SPHERE_SEGMENTS = (512, 256)  # (around, pole to pole): fine, for mirrors and gl
 EMITTER_SPHERE_SEGMENTS = (128, 64)
 
 
-def uv_sphere_area_scale(nu, nv):
-    """Radius factor that gives the inscribed UV polyhedron the sphere's area (and so, by Cauchy's
-    formula, its mean projected area: what a light's power and far irradiance depend on)."""
-    th = np.linspace(0, math.pi, nv + 1)
-    ph = np.linspace(0, 2 * math.pi, nu + 1)
-    T, Ph = np.meshgrid(th, ph, indexing="ij")
-    P = np.stack([np.sin(T) * np.cos(Ph), np.sin(T) * np.sin(Ph), np.cos(T)], axis=-1)
-    a, b, c, d = P[:-1, :-1], P[:-1, 1:], P[1:, 1:], P[1:, :-1]
-    area = 0.5 * (np.linalg.norm(np.cross(d - a, c - a), axis=-1).sum() +
-                  np.linalg.norm(np.cross(c - a, b - a), axis=-1).sum())
-    return math.sqrt(4 * math.pi / area)
-
-
 def make_sphere(segments=SPHERE_SEGMENTS, match_area=False):
     """Unit UV sphere with exact radial per-corner normals; with match_area its vertices are pushed
-    out by uv_sphere_area_scale. Mitsuba's uv = (phi/2pi, theta/pi) with phi = atan2(y, x),
+    out so that the inscribed polyhedron has the sphere's area (and so, by Cauchy's formula, its
+    mean projected area: what a light's power and far irradiance depend on). Mitsuba's uv = (phi/2pi, theta/pi) with phi = atan2(y, x),
     theta = acos(z); Blender v = 1 - v_mitsuba."""
     nu, nv = segments
     th = np.linspace(0, math.pi, nv + 1)
@@ -946,12 +934,13 @@ def make_sphere(segments=SPHERE_SEGMENTS, match_area=False):
     t1 = np.stack([a, c, b], axis=-1).reshape(-1, 3)
     tris = np.concatenate([t0, t1])
     p = P[tris]
-    area = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    area = np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)  # twice each area
     tris = tris[area > 1e-14]  # the degenerate pole triangles
+    scale = math.sqrt(4 * math.pi / (0.5 * area.sum())) if match_area else 1.0
     uv_m = np.stack([Ph.ravel() / (2 * math.pi), T.ravel() / math.pi], axis=1)
     uv = np.stack([uv_m[:, 0], 1 - uv_m[:, 1]], axis=1)[tris]
     normals = P[tris]  # unit sphere: the normal is the position
-    return P * (uv_sphere_area_scale(nu, nv) if match_area else 1.0), tris, normals, uv
+    return P * scale, tris, normals, uv
 
 
 # --------------------------------------------------------------------------------------------
@@ -1356,7 +1345,7 @@ class Loader:
             if any(ch.tag == "emitter" for ch in p.children):
                 segs = EMITTER_SPHERE_SEGMENTS
                 P, tris, normals, uvs = make_sphere(segs, match_area=True)
-                scale = uv_sphere_area_scale(*segs)
+                scale = float(np.linalg.norm(P[0]))  # every vertex sits at the pushed-out radius
                 approximation("emitting sphere shapes are tessellated: %dx%d-segment UV sphere with exact "
                               "radial vertex normals, vertices at %.5f x radius so that its area is the "
                               "sphere's (faces within %.1e x radius of the true sphere; finer meshes lose "
