@@ -69,6 +69,8 @@ def render(kind, args, scene, spp, seed, path):
     """Renders unless cached; returns render seconds (the renderer's own count)."""
     tool = os.path.join(ROOT, "tools", "cycles_reference.py") if kind == "cycles" else args.bin
     settings = {"kind": kind, "scene": scene, "scene_sha1": content_sha1(scene), "res": args.res, "spp": spp, "seed": seed, "code": fingerprint(tool)}
+    if kind == "cycles":
+        settings["pattern"] = args.cycles_pattern
     old = cached(path, settings, args.force)
     if old:
         return old["seconds"]
@@ -76,7 +78,8 @@ def render(kind, args, scene, spp, seed, path):
     if kind == "cycles":
         run([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
              os.path.join(ROOT, "tools", "cycles_reference.py"), "--", scene, "--res", res, "--spp", str(spp),
-             "--seed", str(seed), "--threads", str(args.threads), "--out", path], env=blender_env(args.blender))
+             "--seed", str(seed), "--threads", str(args.threads), "--pattern", args.cycles_pattern, "--out", path],
+            env=blender_env(args.blender))
         with open(path + ".json") as f:
             side = json.load(f)
         seconds = float(side["render_time_s"])  # bpy.ops.render.render: sync, BVH and sampling
@@ -124,6 +127,9 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "apps", "latentpt"))
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--no-cycles", action="store_true", help="leave the Cycles column empty")
+    ap.add_argument("--cycles-pattern", choices=("pmj", "sobol"), default="pmj",
+                    help="Cycles' sampling pattern (tools/cycles_reference.py --pattern); default pmj, Blender's own "
+                         "default, as the documented runs used")
     ap.add_argument("--diffuse-mirrors", action="store_true",
                     help="smooth conductors made diffuse (a rewritten copy of the scene, its own reference): "
                          "how much of the noise is light that mirrors reflect onto diffuse surfaces")
