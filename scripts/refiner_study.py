@@ -107,6 +107,13 @@ VARIANTS = {
     "mse_750_cosine_whole_view": ("latent MSE on the whole view (no crops), 750 steps, lr falling along a half "
                                   "cosine: twice the pixels of mse_6000_cosine's 32² crops",
                                   MSE + ["--crop", "0", "--lr-decay", "cosine"], False, 750),
+    "mse_375_cosine_whole_view": ("latent MSE on the whole view (no crops), 375 steps, lr falling along a half "
+                                  "cosine: at 128² latents the pixels of mse_6000_cosine's 32² crops",
+                                  MSE + ["--crop", "0", "--lr-decay", "cosine"], False, 375),
+    # At 64² latents (Lamp, Living Room) a whole view is 4 crops: 3000 steps are twice the preset's pixels.
+    "mse_3000_cosine_whole_view": ("latent MSE on the whole view (no crops), 3000 steps, lr falling along a half "
+                                   "cosine: at 64² latents twice the pixels of mse_6000_cosine's 32² crops",
+                                   MSE + ["--crop", "0", "--lr-decay", "cosine"], False, 3000),
     # Run with a binary whose early stopping followed the mean of per-view EMAs (session 12, not
     # kept: it stopped at 4199 where mse_6000_cosine_dihedral, the same options, stopped at 4251).
     "mse_6000_cosine_dihedral_per_view": ("mse_6000_cosine_dihedral with early stopping on the mean of per-view EMAs",
