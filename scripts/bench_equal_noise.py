@@ -170,7 +170,7 @@ def main():
         for spp in ladder_spp:
             secs, errs = [], []
             for seed in range(1, args.seeds + 1):
-                exr = os.path.join(folder, "%s_%d_s%d.exr" % (kind, spp, seed))
+                exr = os.path.join(folder, "%s_%s_%d_s%d.exr" % (kind, args.cycles_pattern, spp, seed))
                 secs.append(render(kind, args, scene, spp, seed, exr))
                 errs.append(rel_mse(args, exr, ref, scene))
             pts.append((spp, sum(secs) / len(secs), sum(errs) / len(errs)))
@@ -192,9 +192,10 @@ def main():
             why = "not run (--no-cycles)" if args.no_cycles else "no Blender: `apt-get install blender`"
             lines.append("| Cycles | – (%s) | – | – | – | – |" % why)
             continue
-        name = {"independent": "latentpt independent", "sobol": "latentpt sobol", "cycles": "Cycles (CPU)"}[kind]
+        label = {"independent": "latentpt independent", "sobol": "latentpt sobol",
+                 "cycles": "Cycles (CPU, %s pattern)" % args.cycles_pattern}[kind]
         lines.append("| %s | %s | %s | %s | %s | %s |" % (
-            name, cell(r and r[0], "%.1f"), cell(r and r[1], "%.2f"), cell(r and ind and ind[0] / r[0], "%.2f×"),
+            label, cell(r and r[0], "%.1f"), cell(r and r[1], "%.2f"), cell(r and ind and ind[0] / r[0], "%.2f×"),
             cell(r and ind and ind[1] / r[1], "%.2f×"), cell(r and cyc and cyc[1] / r[1], "%.2f×")))
     lines += ["", "Ladder (spp, seconds, relMSE):", ""]
     for kind, pts in ladders.items():
@@ -203,7 +204,8 @@ def main():
     write_atomic(os.path.join(folder, "report.md"), text)
     write_atomic(os.path.join(folder, "report.json"), json.dumps(
         {"scene": name, "res": args.res, "target": target, "target_spp": args.target_spp, "reference": ref_note,
-         "threads": args.threads, "ladders": ladders, "reach": reach}, indent=1) + "\n")
+         "threads": args.threads, "cycles_pattern": args.cycles_pattern if have_blender else None, "ladders": ladders,
+         "reach": reach}, indent=1) + "\n")
     print(text)
 
 

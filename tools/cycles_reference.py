@@ -30,9 +30,10 @@ usage:
                     path runs to max_depth. Slow; for checking Cycles' roulette, which loses
                     energy on long paths (docs/validation.md, "A furnace").
   --pattern P       Cycles' sampling pattern: sobol (default) or pmj (progressive multi-jittered,
-                    Blender's default). With pmj, Cycles 3.4's direct light from a 16 k-triangle
-                    sphere light seen from its side is biased at low sample counts: +0.65 % at
-                    64-256 spp, +0.2 % at 512, none at 1024-2048 (against a closed form;
+                    Blender's default). With pmj, Cycles 3.4's direct light from a
+                    16 k-triangle sphere light is biased at low sample counts, by up to ~0.7 %
+                    of either sign with the geometry (dining-room: +0.65 % at 64-256 spp,
+                    +0.2 % at 512, none at 1024-2048, against a closed form;
                     docs/validation.md, "dining-room's last offset"); sobol showed none. pmj
                     prints an APPROXIMATION.
   --help            this text
@@ -2044,11 +2045,17 @@ def configure_render(sc, args, width, height, spp, bounces, film_filter):
     cy.feature_set = "SUPPORTED"
     cy.samples = spp
     cy.use_adaptive_sampling = False
-    cy.sampling_pattern = SAMPLING_PATTERNS[args["pattern"]]
+    pattern = SAMPLING_PATTERNS[args["pattern"]]
+    known = [i.identifier for i in cy.bl_rna.properties["sampling_pattern"].enum_items]
+    if pattern not in known:  # the names changed after Blender 3.4
+        raise SceneError("--pattern %s: this Blender's Cycles has no '%s' sampling pattern (it has %s)"
+                         % (args["pattern"], pattern, ", ".join(known)))
+    cy.sampling_pattern = pattern
     if args["pattern"] == "pmj":
         approximation("progressive multi-jittered samples (--pattern pmj) bias Cycles 3.4's direct light from a "
-                      "16 k-triangle sphere light seen from its side at low sample counts: +0.65 % at 64-256 spp, "
-                      "+0.2 % at 512, none at 1024-2048 (closed form, docs/validation.md); --pattern sobol showed none")
+                      "tessellated (16 k-triangle) sphere light at low sample counts, by up to ~0.7 % of either sign "
+                      "with the geometry: dining-room +0.65 % at 64-256 spp, +0.2 % at 512, none at 1024-2048 "
+                      "(closed form, docs/validation.md); --pattern sobol showed none")
     cy.use_denoising = False
     cy.use_preview_denoising = False
     cy.sample_clamp_direct = 0.0
