@@ -102,6 +102,8 @@ def render_once(kind, args, scene_path, out_exr, seed, extra, log):
     tool = args.bin if kind == "ours" else os.path.join(ROOT, "tools", "cycles_reference.py")
     settings = {"kind": kind, "scene": scene_path, "scene_sha1": content_sha1(scene_path), "res": args.res,
                 "spp": args.spp // 2, "seed": seed, "extra": extra, "code": fingerprint(tool)}
+    if kind == "cycles":
+        settings["pattern"] = args.cycles_pattern
     stamp = out_exr + ".settings"
     if not args.force and os.path.exists(out_exr) and os.path.exists(stamp):
         with open(stamp) as f:
@@ -115,7 +117,8 @@ def render_once(kind, args, scene_path, out_exr, seed, extra, log):
     else:
         cmd = [args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                os.path.join(ROOT, "tools", "cycles_reference.py"), "--", scene_path, "--res", res, "--spp",
-               str(args.spp // 2), "--seed", str(seed), "--threads", str(args.threads), "--out", out_exr] + extra
+               str(args.spp // 2), "--seed", str(seed), "--threads", str(args.threads), "--pattern", args.cycles_pattern,
+               "--out", out_exr] + extra
     seconds = run(cmd, log, blender_env(args.blender) if kind == "cycles" else None)
     settings["seconds"] = seconds
     tmp = stamp + ".tmp"
@@ -250,6 +253,10 @@ def main():
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "apps", "latentpt"))
     ap.add_argument("--blender", default="blender")
     ap.add_argument("--force", action="store_true", help="re-render even where finished renders exist")
+    ap.add_argument("--cycles-pattern", choices=("sobol", "pmj"), default="sobol",
+                    help="Cycles' sampling pattern (tools/cycles_reference.py --pattern): sobol, or pmj (Blender's "
+                         "default, biased at low sample counts on tessellated sphere lights; the runs before "
+                         "2026-11-26 evening used it)")
     ap.add_argument("-D", dest="defines", action="append", default=[], help="scene override for both renderers, e.g. max_depth=6")
     ap.add_argument("--flat-shading", action="store_true",
                     help="both renderers render every obj/ply mesh with face normals (a rewritten copy of the scene): "
