@@ -9,19 +9,18 @@
 // scalar key "alpha" (roughness), ∂/∂α of eval and of the weight, docs/bsdfs.md (37)-(40), (43).
 // cycles_approximation (bool, validation only): F at the macro normal, core/bsdfs/cycles_approximation.h.
 // Equations: docs/bsdfs.md (10), (12), (15)-(16), (30)-(31), (37)-(40), (43), (47).
-#include "core/bsdf.h"
 #include "core/bsdfs/cycles_approximation.h"
 #include "core/bsdfs/fresnel.h"
-#include "core/bsdfs/microfacet.h"
+#include "core/bsdfs/microfacet_bsdf.h"
 
 namespace lpt {
 namespace {
 
 template <int N>
-class RoughConductor final : public BSDF<N> {
+class RoughConductor final : public MicrofacetBSDF<N> {
 public:
     explicit RoughConductor(const Props& props)
-        : m_distr(read_distribution(props), read_alpha(props)),
+        : MicrofacetBSDF<N>(props),
           m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
           m_ior(read_conductor_ior<N>(props)),
           m_cycles_approximation(read_cycles_approximation<N>(props)) {}
@@ -82,17 +81,6 @@ public:
         m_specular = v;
     }
 
-    std::vector<std::string> scalar_keys() const override { return {"alpha"}; }
-    float get_scalar(const std::string& key) const override {
-        if (key != "alpha") return BSDF<N>::get_scalar(key);
-        return m_distr.alpha();
-    }
-    /// Raised to MicrofacetDistribution::kMinAlpha (1e-4) as at construction; nothing else
-    /// caches alpha. Non-finite values throw std::invalid_argument.
-    void set_scalar(const std::string& key, float value) override {
-        if (key != "alpha") BSDF<N>::set_scalar(key, value);
-        m_distr.set_alpha(value);
-    }
     /// ∂(f·|cos wo|)/∂α = specular_reflectance · F(wi·h) (∂D G + D ∂G) / (4 cos θi),
     /// docs/bsdfs.md (40): (15) by the product rule with (37)-(39); same zero cases as eval.
     /// weight_grad_scalar keeps the base-class default (∂eval/∂α)/pdf, docs/bsdfs.md (43):
@@ -115,7 +103,7 @@ private:
         return m_ior.fresnel(m_cycles_approximation ? cos_theta(wi) : wi.dot(m));
     }
 
-    MicrofacetDistribution m_distr;
+    using MicrofacetBSDF<N>::m_distr;  // nothing here caches alpha
     Spectrum<N> m_specular;
     ConductorIOR<N> m_ior;
     bool m_cycles_approximation;

@@ -9,18 +9,17 @@
 // Gradients w.r.t. the two colours (keys 0 and 1): docs/bsdfs.md (32)-(33); w.r.t. the scalar
 // key "alpha" (roughness): docs/bsdfs.md (37)-(39), (41), (43).
 // Equations: docs/bsdfs.md (1)-(2), (7)-(12), (18)-(21), (32)-(33), (37)-(39), (41), (43).
-#include "core/bsdf.h"
 #include "core/bsdfs/fresnel.h"
-#include "core/bsdfs/microfacet.h"
+#include "core/bsdfs/microfacet_bsdf.h"
 
 namespace lpt {
 namespace {
 
 template <int N>
-class RoughDielectric final : public BSDF<N> {
+class RoughDielectric final : public MicrofacetBSDF<N> {
 public:
     explicit RoughDielectric(const Props& props)
-        : m_distr(read_distribution(props), read_alpha(props)),
+        : MicrofacetBSDF<N>(props),
           m_eta(read_relative_ior(props, 1.5046f, 1.000277f, true)),
           m_reflectance(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
           m_transmittance(spectrum_from_rgb<N>(props.get_rgb("specular_transmittance", Eigen::Array3f::Ones()))) {}
@@ -135,17 +134,6 @@ public:
         else BSDF<N>::set_spectral(key, v);
     }
 
-    std::vector<std::string> scalar_keys() const override { return {"alpha"}; }
-    float get_scalar(const std::string& key) const override {
-        if (key != "alpha") return BSDF<N>::get_scalar(key);
-        return m_distr.alpha();
-    }
-    /// Raised to MicrofacetDistribution::kMinAlpha (1e-4) as at construction; nothing else
-    /// caches alpha. Non-finite values throw std::invalid_argument.
-    void set_scalar(const std::string& key, float value) override {
-        if (key != "alpha") BSDF<N>::set_scalar(key, value);
-        m_distr.set_alpha(value);
-    }
     /// ∂(f·|cos wo|)/∂α, docs/bsdfs.md (41): (19) and (20) with D G replaced by
     /// ∂(D G)/∂α = ∂D G + D ∂G from (37)-(39). D, G >= 0, so |(1 - F) D G X| = D G |(1 - F) X|
     /// and the absolute value passes to the α-free factor. F, η, the half vector and s (18) do
@@ -216,7 +204,7 @@ private:
         return ctx.mode == TransportMode::Radiance ? 1.f / (eta * eta) : 1.f;
     }
 
-    MicrofacetDistribution m_distr;
+    using MicrofacetBSDF<N>::m_distr;  // nothing here caches alpha
     float m_eta;
     Spectrum<N> m_reflectance, m_transmittance;
 };

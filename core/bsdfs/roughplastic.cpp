@@ -24,11 +24,10 @@
 // cycles_approximation (bool, validation only; core/bsdfs/cycles_approximation.h): t(cos θo) by
 // T̄, and the specular Fresnel by R(cos θi)/A_glossy(cos θi) at the macro normal.
 // Equations: docs/bsdfs.md (7)-(10), (12), (25)-(28), (34), (36)-(39), (42)-(43), (46), (49).
-#include "core/bsdf.h"
 #include "core/bsdfs/cycles_approximation.h"
 #include "core/bsdfs/fresnel.h"
+#include "core/bsdfs/microfacet_bsdf.h"
 #include "core/bsdfs/plastic_substrate.h"
-#include "core/bsdfs/microfacet.h"
 #include "core/bsdfs/rough_transmittance.h"
 #include "core/warp.h"
 #include <algorithm>
@@ -37,10 +36,10 @@ namespace lpt {
 namespace {
 
 template <int N>
-class RoughPlastic final : public BSDF<N> {
+class RoughPlastic final : public MicrofacetBSDF<N> {
 public:
     explicit RoughPlastic(const Props& props)
-        : m_distr(read_distribution(props), read_alpha(props)),
+        : MicrofacetBSDF<N>(props),
           m_eta(read_relative_ior(props, 1.49f, 1.000277f, true)),
           m_substrate(props),
           m_specular(spectrum_from_rgb<N>(props.get_rgb("specular_reflectance", Eigen::Array3f::Ones()))),
@@ -59,23 +58,6 @@ public:
     void set_spectral(const std::string& key, const Spectrum<N>& v) override {
         if (key == "specular_reflectance") m_specular = v;
         else if (!m_substrate.set(key, v)) BSDF<N>::set_spectral(key, v);
-    }
-
-    std::vector<std::string> scalar_keys() const override { return {"alpha"}; }
-    float get_scalar(const std::string& key) const override {
-        if (key != "alpha") return BSDF<N>::get_scalar(key);
-        return m_distr.alpha();
-    }
-    /// Raised to MicrofacetDistribution::kMinAlpha (1e-4) as at construction, then everything
-    /// derived from alpha is rebuilt: t(mu) and ∂t/∂α tables, Fdr_int, ρ̃ and their
-    /// α-derivatives (skipped when the clamped value is unchanged). Interpolates cached tables
-    /// (docs/bsdfs.md (46)): microseconds, plus 40–90 ms for each node α not met before.
-    /// Non-finite values throw std::invalid_argument.
-    void set_scalar(const std::string& key, float value) override {
-        if (key != "alpha") BSDF<N>::set_scalar(key, value);
-        float old = m_distr.alpha();
-        m_distr.set_alpha(value);
-        if (m_distr.alpha() != old) rebuild();  // the tables depend on alpha only
     }
 
     Spectrum<N> eval(const BSDFContext& ctx, const Vec3f& wi, const Vec3f& wo) const override {
@@ -169,6 +151,11 @@ public:
     }
 
 private:
+    /// set_scalar("alpha") rebuilds everything derived from alpha: t(mu) and ∂t/∂α tables,
+    /// Fdr_int, ρ̃ and their α-derivatives. Interpolates cached tables (docs/bsdfs.md (46)):
+    /// microseconds, plus 40–90 ms for each node α not met before.
+    void alpha_changed() override { rebuild(); }
+
     // Everything derived from alpha: t and ∂t/∂α (26), (46), Fdr_int and its α-derivative (27), ρ̃.
     void rebuild() {
         m_tables = rough_transmittance(m_distr.type(), m_eta, m_distr.alpha());
@@ -202,7 +189,7 @@ private:
                                       : fresnel_dielectric(wi.dot(h), m_eta).R;
     }
 
-    MicrofacetDistribution m_distr;
+    using MicrofacetBSDF<N>::m_distr;
     float m_eta, m_inv_eta2 = 1.f;
     PlasticSubstrate<N> m_substrate;  ///< ρ̃ after internal bounces, docs/bsdfs.md (23)
     Spectrum<N> m_specular;
