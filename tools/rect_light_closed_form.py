@@ -44,6 +44,7 @@ import math
 import os
 import subprocess
 import sys
+import tempfile
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -54,11 +55,22 @@ def fail(msg):
     sys.exit(2)
 
 
+def floats_of(node, where):
+    text = node.get("value")
+    try:
+        return [float(v) for v in (text or "").replace(",", " ").split()]
+    except ValueError:
+        fail(f"{where}: value '{text}' is not a list of numbers")
+
+
 def matrix_of(elem, where):
     m = elem.find("transform/matrix")
     if m is None:
         fail(f"{where}: to_world must be one <matrix> (the only form this check reads)")
-    vals = [float(v) for v in m.get("value").replace(",", " ").split()]
+    flip = elem.find("boolean[@name='flip_normals']")
+    if flip is not None and flip.get("value") == "true":
+        fail(f"{where}: flip_normals is not read by this check")
+    vals = floats_of(m, f"{where} to_world matrix")
     if len(vals) != 16:
         fail(f"{where}: to_world matrix needs 16 values, got {len(vals)}")
     return np.array(vals).reshape(4, 4)
@@ -68,7 +80,9 @@ def rgb_of(elem, name, where):
     node = elem.find(f"rgb[@name='{name}']")
     if node is None:
         fail(f"{where}: no <rgb name=\"{name}\">")
-    vals = [float(v) for v in node.get("value").replace(",", " ").split()]
+    vals = floats_of(node, f"{where} rgb '{name}'")
+    if len(vals) not in (1, 3):
+        fail(f"{where}: rgb '{name}' needs 1 or 3 values, got {len(vals)}")
     return np.array(vals if len(vals) == 3 else vals * 3)
 
 
@@ -91,6 +105,7 @@ def load_scene(path, emitter_id, receiver_id):
     if bsdf is None:
         ref = rec.find("ref")
         bsdf = bsdfs.get(ref.get("id")) if ref is not None else None
+    twosided = bsdf is not None and bsdf.get("type") == "twosided"
     while bsdf is not None and bsdf.get("type") == "twosided":
         bsdf = bsdf.find("bsdf")
     if bsdf is None or bsdf.get("type") != "diffuse":
@@ -108,7 +123,7 @@ def load_scene(path, emitter_id, receiver_id):
     return dict(light=matrix_of(shapes[emitter_id], f"{path}: shape '{emitter_id}'"),
                 receiver=matrix_of(rec, f"{path}: shape '{receiver_id}'"),
                 camera=matrix_of(sensor, f"{path}: sensor"),
-                fov=float(fov.get("value")), radiance=radiance, rho=rho)
+                fov=floats_of(fov, f"{path}: sensor fov")[0], radiance=radiance, rho=rho, twosided=twosided)
 
 
 def camera_rays(scene, res, rows, cols, sub):
@@ -135,6 +150,22 @@ def receiver_points(scene, origin, dirs):
     return p, normal, inside
 
 
+def check_sides(scene, origin):
+    """The formula counts the whole emitter: it must lie on the side of the receiver the camera
+    sees, and a one-sided receiver must be seen from its front."""
+    m, light = scene["receiver"], scene["light"]
+    centre = m[:3, 3]
+    normal = np.linalg.inv(m[:3, :3]).T @ np.array([0, 0, 1.0])
+    cam_side = (origin - centre) @ normal
+    if not scene["twosided"] and cam_side <= 0:
+        return "the camera sees the back of the one-sided receiver"
+    for x, y in [(-1, -1), (1, -1), (1, 1), (-1, 1)]:
+        corner = (light @ np.array([x, y, 0, 1.0]))[:3]
+        if ((corner - centre) @ normal) * cam_side <= 0:
+            return "the emitter is not wholly on the camera's side of the receiver"
+    return None
+
+
 def polygon_irradiance_factor(scene, p, n):
     """|sum beta_k n.c_k| / 2 for the emitter's quad; zero behind its emitting (+z local) side."""
     m = scene["light"]
@@ -151,7 +182,10 @@ def polygon_irradiance_factor(scene, p, n):
 
 
 def read_exr(path, res):
-    out = subprocess.run(["oiiotool", "--info", "--dumpdata", path], capture_output=True, text=True)
+    try:
+        out = subprocess.run(["oiiotool", "--info", "--dumpdata", path], capture_output=True, text=True)
+    except OSError as e:
+        fail(f"{path}: cannot run oiiotool (openimageio-tools): {e}")
     if out.returncode != 0:
         fail(f"{path}: oiiotool could not read it: {out.stderr.strip()}")
     img = np.zeros((res, res, 3))
@@ -184,14 +218,19 @@ def write_png(path, strips, scale):
     gap = np.full((4, strips[0].shape[1], 3), 128, np.uint8)
     row = np.concatenate(sum(([s, gap] for s in strips), [])[:-1], axis=0)
     row = row.repeat(scale, 0).repeat(scale, 1)
-    ppm = path + ".ppm"
-    with open(ppm, "wb") as f:
-        f.write(f"P6 {row.shape[1]} {row.shape[0]} 255\n".encode())
-        f.write(row.tobytes())
-    tmp = path + ".tmp.png"
-    subprocess.run(["oiiotool", ppm, "-o", tmp], check=True)
-    os.replace(tmp, path)
-    os.remove(ppm)
+    folder = os.path.dirname(os.path.abspath(path))
+    with tempfile.TemporaryDirectory(dir=folder) as tmpdir:  # beside the output: os.replace is atomic
+        ppm, png = os.path.join(tmpdir, "ratio.ppm"), os.path.join(tmpdir, "ratio.png")
+        with open(ppm, "wb") as f:
+            f.write(f"P6 {row.shape[1]} {row.shape[0]} 255\n".encode())
+            f.write(row.tobytes())
+        try:
+            done = subprocess.run(["oiiotool", ppm, "-o", png], capture_output=True, text=True)
+        except OSError as e:
+            fail(f"--png {path}: cannot run oiiotool (openimageio-tools): {e}")
+        if done.returncode != 0:
+            fail(f"--png {path}: oiiotool could not write it: {done.stderr.strip()}")
+        os.replace(png, path)
 
 
 def parse_range(text, name):
@@ -221,9 +260,17 @@ def main():
     rows, cols = parse_range(args.rows, "--rows"), parse_range(args.cols, "--cols")
     if rows[1] > args.res or cols[1] > args.res:
         fail("--rows/--cols reach outside the image")
+    for name, value in (("--sub", args.sub), ("--band", args.band), ("--res", args.res)):
+        if value < 1:
+            fail(f"{name} {value}: must be at least 1")
+    if not args.range > 0:
+        fail(f"--range {args.range}: must be positive")
     scene = load_scene(args.scene, args.emitter, args.receiver)
 
     origin, dirs = camera_rays(scene, args.res, rows, cols, args.sub)
+    problem = check_sides(scene, origin)
+    if problem:
+        fail(f"{args.scene}: '{args.receiver}' and '{args.emitter}': {problem}")
     p, n, inside = receiver_points(scene, origin, dirs)
     if not inside.all():
         fail(f"--rows {args.rows} --cols {args.cols}: part of the region does not see '{args.receiver}'")
