@@ -22,6 +22,8 @@ import os
 import sys
 import xml.etree.ElementTree as ET
 
+import mitsuba_transform
+
 
 def fail(msg):
     print("coplanar_faces: " + msg, file=sys.stderr)
@@ -77,45 +79,13 @@ def read_obj(path):
     return verts, tris
 
 
-def matmul(a, b):
-    return [[sum(a[r][k] * b[k][c] for k in range(4)) for c in range(4)] for r in range(4)]
-
-
-def transform_step(node, where):
-    """One child of <transform> as a 4x4 matrix: matrix, translate or scale (Mitsuba's attributes),
-    or None for a kind this script does not read."""
-    def number(name, default):
-        try:
-            return float(node.get(name, default))
-        except ValueError:
-            fail("%s: field %s: '%s' is not a number" % (where, name, node.get(name)))
-    if node.tag == "matrix":
-        try:
-            m = [float(v) for v in (node.get("value") or "").replace(",", " ").split()]
-        except ValueError:
-            m = []
-        if len(m) != 16:
-            fail("%s: field to_world: <matrix value> needs 16 numbers" % where)
-        return [m[0:4], m[4:8], m[8:12], m[12:16]]
-    if node.tag == "translate":
-        return [[1, 0, 0, number("x", 0)], [0, 1, 0, number("y", 0)], [0, 0, 1, number("z", 0)], [0, 0, 0, 1]]
-    if node.tag == "scale":
-        v = number("value", 1)
-        return [[number("x", v), 0, 0, 0], [0, number("y", v), 0, 0], [0, 0, number("z", v), 0], [0, 0, 0, 1]]
-    return None
-
-
 def to_world(shape, xml_path):
     """The shape's 4x4 to_world (identity without one), or None when it uses a transform this
     script does not read (rotate, lookat): the caller skips that shape and says so."""
-    M = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
-    t = shape.find("transform[@name='to_world']")
-    for node in ([] if t is None else list(t)):
-        step = transform_step(node, "%s: shape '%s'" % (xml_path, shape.get("id")))
-        if step is None:
-            return None
-        M = matmul(step, M)  # Mitsuba applies a transform's children in order
-    return M
+    try:
+        return mitsuba_transform.to_world(shape, "%s: shape '%s'" % (xml_path, shape.get("id")))
+    except ValueError as e:
+        fail(str(e))
 
 
 def scene_meshes(xml_path):

@@ -23,7 +23,8 @@ usage:
         --res N [--sub S] [--range R] [--png FILE] LABEL=EXR[,EXR] ...
 
   SCENE.xml      the Mitsuba 3 scene the renders were made from (rectangles and a perspective
-                 sensor given by <matrix> to_world; the receiver's BSDF diffuse or twosided diffuse)
+                 sensor whose to_world is matrix / translate / scale, tools/mitsuba_transform.py;
+                 the receiver's BSDF diffuse or twosided diffuse)
   --emitter ID   id of the rectangle shape carrying the area emitter
   --receiver ID  id of the diffuse rectangle to check
   --rows A:B     image rows A..B-1 to check (the receiver must be unoccluded there, both from the
@@ -49,6 +50,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+import mitsuba_transform
+
 
 def fail(msg):
     print(f"rect_light_closed_form: {msg}", file=sys.stderr)
@@ -64,16 +67,16 @@ def floats_of(node, where):
 
 
 def matrix_of(elem, where):
-    m = elem.find("transform/matrix")
-    if m is None:
-        fail(f"{where}: to_world must be one <matrix> (the only form this check reads)")
     flip = elem.find("boolean[@name='flip_normals']")
     if flip is not None and flip.get("value") == "true":
         fail(f"{where}: flip_normals is not read by this check")
-    vals = floats_of(m, f"{where} to_world matrix")
-    if len(vals) != 16:
-        fail(f"{where}: to_world matrix needs 16 values, got {len(vals)}")
-    return np.array(vals).reshape(4, 4)
+    try:
+        m = mitsuba_transform.to_world(elem, where)
+    except ValueError as e:
+        fail(str(e))
+    if m is None:
+        fail(f"{where}: to_world uses a transform this check does not read (matrix, translate, scale only)")
+    return np.array(m, dtype=float)
 
 
 def rgb_of(elem, name, where):
