@@ -242,6 +242,11 @@ struct Cli {
         fit->add_option("--lr-period", f.job.options.lr_period, "iterations per restart period")
             ->capture_default_str()
             ->check(positive());
+        fit->add_option("--emission-decay", f.job.options.emission_decay,
+                        "lambda of the L2 penalty lambda * sum Le^2 on every emitter's latent radiance; 0 = off "
+                        "(docs/fitting.md (17))")
+            ->capture_default_str()
+            ->check(non_negative());
         fit->add_option("--patience", f.job.options.patience,
                         "early stopping: iterations without improvement of the smoothed loss; 0 = off")
             ->capture_default_str()

@@ -65,6 +65,22 @@ void record_kept_parameters(FitState& state, const EarlyStopping& stopper, int p
 
 }  // namespace
 
+double add_emission_decay(ParamStore& ps, float lambda) {
+    if (lambda == 0.f) return 0.0;
+    double penalty = 0.0;
+    for (size_t k = 0; k < ps.slice_count(); ++k) {
+        const ParamSlice& sl = ps.slice(int(k));
+        if (sl.kind != "Le") continue;
+        const float* v = ps.value(int(k));
+        float* g = ps.grad_value(int(k));
+        for (int c = 0; c < sl.channels; ++c) {
+            penalty += double(lambda) * v[c] * v[c];
+            g[c] += 2.f * lambda * v[c];
+        }
+    }
+    return penalty;
+}
+
 FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o,
                     FitState state, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
     const size_t n = size_t(width) * height * kLatentChannels;
@@ -111,6 +127,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         ps.zero_grad();
         if (K == 0) backward_latent(model, ro, d_image);
         else replay_backward(model, *records, d_image);
+        loss += add_emission_decay(ps, o.emission_decay);
         ps.backward();
         const float lr = schedule.lr_at(it);
         size_t bad = adam.step(ps.raw().data(), ps.grad_raw().data(), ps.raw().size(), lr);

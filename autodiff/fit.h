@@ -19,6 +19,10 @@ struct FitOptions {
     float lr = 1e-3f, lr_min = 0.f;
     int lr_period = 500, lr_t_mult = 1;
     float huber_delta = 1.f;
+    /// λ of the penalty λ·Σ L̃e² on every emitter's latent radiance (docs/fitting.md (17)); 0 = off.
+    /// With the flat term, a light's L̃e + L̃a is all its own pixels see, so the loss alone leaves
+    /// L̃e free to grow along that valley (and its indirect noise with it).
+    float emission_decay = 0.f;
     ToneCurve tone = ToneCurve::Clip;
     int patience = 300;  ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
@@ -54,6 +58,10 @@ struct FitState {
     int skipped_steps = 0;        ///< iterations whose gradient had NaN/Inf (step refused)
     std::vector<FitRecord> history;
 };
+
+/// Emission decay: the penalty λ·Σ L̃e² over every "Le" slice (docs/fitting.md (17)): adds its
+/// derivative 2λ·L̃e to the value gradients (before ParamStore::backward) and returns its value.
+double add_emission_decay(ParamStore& params, float lambda);
 
 /// Latent render with the fit's tone curve applied: what the loss compares with the target.
 std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone);

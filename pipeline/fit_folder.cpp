@@ -98,6 +98,7 @@ nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, 
                    {"seconds", state.history.empty() ? 0.0 : state.history.back().seconds},
                    {"spp", o.spp},
                    {"reuse_paths", o.reuse_paths},
+                   {"emission_decay", o.emission_decay},
                    {"skipped_steps", state.skipped_steps}};
     return m;
 }
