@@ -220,6 +220,29 @@ struct Cli {
             ->check(positive());
     }
 
+    /// The latent model and its objective: what is fitted, and the penalty on it.
+    void add_fit_model() {
+        fit->add_option("--tone", fit_tone,
+                        "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
+            ->check(CLI::IsMember({"clip", "reinhard", "logit"}))
+            ->capture_default_str();
+        fit->add_option(
+               "--param", f.job.param,
+               "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
+            ->check(CLI::IsMember({"code", "paper", "classic"}))
+            ->capture_default_str();
+        fit->add_option("--gate", f.job.gate, "Ic gate: shadowed (1 - V) or visible (V)")
+            ->check(CLI::IsMember({"shadowed", "visible"}))
+            ->capture_default_str();
+        fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")
+            ->capture_default_str();
+        fit->add_option("--emission-decay", f.job.options.emission_decay,
+                        "lambda of the L2 penalty lambda * sum Le^2 on every emitter's latent radiance; 0 = off "
+                        "(docs/fitting.md (17))")
+            ->capture_default_str()
+            ->check(non_negative());
+    }
+
     /// The optimiser, the target's RGB reference, the VAE, stage 2: the rest of fit's options.
     void add_fit_optimisation() {
         fit->add_option("--iterations", f.job.options.iterations, "optimiser steps")
@@ -242,11 +265,6 @@ struct Cli {
         fit->add_option("--lr-period", f.job.options.lr_period, "iterations per restart period")
             ->capture_default_str()
             ->check(positive());
-        fit->add_option("--emission-decay", f.job.options.emission_decay,
-                        "lambda of the L2 penalty lambda * sum Le^2 on every emitter's latent radiance; 0 = off "
-                        "(docs/fitting.md (17))")
-            ->capture_default_str()
-            ->check(non_negative());
         fit->add_option("--patience", f.job.options.patience,
                         "early stopping: iterations without improvement of the smoothed loss; 0 = off")
             ->capture_default_str()
@@ -254,20 +272,6 @@ struct Cli {
         fit->add_option("--min-delta", f.job.options.min_delta, "early stopping: smallest improvement that counts")
             ->capture_default_str()
             ->check(non_negative());
-        fit->add_option("--tone", fit_tone,
-                        "signed tone curve: clip or reinhard; logit for the baseline (with --param classic --terms e)")
-            ->check(CLI::IsMember({"clip", "reinhard", "logit"}))
-            ->capture_default_str();
-        fit->add_option(
-               "--param", f.job.param,
-               "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
-            ->check(CLI::IsMember({"code", "paper", "classic"}))
-            ->capture_default_str();
-        fit->add_option("--gate", f.job.gate, "Ic gate: shadowed (1 - V) or visible (V)")
-            ->check(CLI::IsMember({"shadowed", "visible"}))
-            ->capture_default_str();
-        fit->add_option("--terms", f.job.terms, "latent terms to render: any of e, a, c (ablation)")
-            ->capture_default_str();
         fit->add_option("--checkpoint-every", f.job.options.checkpoint_every,
                         "iterations between checkpoints; 0 = only at the end")
             ->capture_default_str()
@@ -280,7 +284,11 @@ struct Cli {
                         "Equal final loss for K = 0, 1, 8, 32 on the CBox (docs/fitting.md)")
             ->capture_default_str()
             ->check(non_negative());
-        fit->add_flag("--resume", f.job.resume, "continue from <out>/checkpoint");
+        fit->add_flag("--resume", f.job.resume,
+                      "continue from <out>/checkpoint; one made with other settings is an error");
+        fit->add_flag("--restart-if-changed", f.job.restart_if_changed,
+                      "with --resume: a checkpoint made with other settings is removed and the fit starts again "
+                      "(workflows)");
         fit->add_flag("--encode", f.job.encode,
                       "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
         fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")
@@ -315,6 +323,7 @@ struct Cli {
             ->capture_default_str();
         fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
             ->capture_default_str();
+        add_fit_model();
         add_fit_optimisation();
     }
 

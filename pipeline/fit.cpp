@@ -3,6 +3,7 @@
 #include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
+#include "pipeline/fit_checkpoint.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/output_lock.h"
 #include "pipeline/reference.h"
@@ -177,6 +178,9 @@ void validate(const FitJob& job) {
         throw std::invalid_argument("--gate is shadowed or visible, got '" + job.gate + "'");
     if (job.ref_tone != "clip" && job.ref_tone != "reinhard")
         throw std::invalid_argument("--ref-tone is clip or reinhard, got '" + job.ref_tone + "'");
+    if (!(job.options.emission_decay >= 0.f) || !std::isfinite(job.options.emission_decay))
+        throw std::invalid_argument("--emission-decay must be a finite number >= 0, got " +
+                                    std::to_string(job.options.emission_decay));
     if (job.refiner) validate(job.refine);
 }
 
@@ -189,6 +193,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     o.checkpoint_dir = (fs::path(job.out) / "checkpoint").string();
 
     const OutputLock lock(job.out);  // before anything is written there
+    const bool resume = prepare_checkpoint(o.checkpoint_dir, stage1_settings(job), job.resume, job.restart_if_changed);
     std::unique_ptr<Vae> vae;
     if (job.encode) vae = open_vae(job.vae);
     const Target target = !job.target.empty() ? load_target_exr(job.target)
@@ -197,7 +202,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     write_latent((fs::path(job.out) / "target.exr").string(), target.width, target.height, target.data);
 
     FitSummary summary;
-    if (job.resume) {
+    if (resume) {
         summary.state = load_checkpoint(o.checkpoint_dir, model);
         report.say("resuming at iteration " + std::to_string(summary.state.next_iteration));
     }
@@ -214,7 +219,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
         RefineJob r = job.refine;
         r.fitdir = job.out;
         r.train.seed = job.options.seed;
-        r.resume = job.resume;
+        r.resume = resume;  // a stage 1 started again makes the old refiner checkpoint stale too
         summary.refined = run_refine(r, report);
     }
     return summary;

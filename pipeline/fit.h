@@ -36,6 +36,9 @@ struct FitJob {
     FitOptions options;
     int final_spp = 256;  ///< samples per pixel of the final render
     bool resume = false;  ///< continue from <out>/checkpoint (and the refiner's)
+    /// With resume: a checkpoint made with other stage-1 settings is removed and the fit starts
+    /// again, instead of an error (pipeline/fit_checkpoint.h). What a workflow wants.
+    bool restart_if_changed = false;
     VaeSource vae;
 
     bool refiner = true;  ///< run stage 2 afterwards

@@ -112,6 +112,7 @@ void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
         else if (k == "gate") job.gate = value.cast<std::string>();
         else if (k == "terms") job.terms = value.cast<std::string>();
         else if (k == "resume") job.resume = value.cast<bool>();
+        else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
         else if (k == "refiner") job.refiner = value.cast<bool>();
         else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
         else if (k == "lpips_dir") job.refine.lpips_dir = value.cast<std::string>();  // fit --lpips-dir
