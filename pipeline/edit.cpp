@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 namespace lpt::pipeline {
@@ -138,6 +139,38 @@ std::string render_frame(const EditJob& job, EditSession& session, const Tools& 
     return row.str();
 }
 
+/// What a frame's files depend on besides its index: the fit (manifest, parameters, refiner), the
+/// edit file and the render settings, as an FNV-1a hash. frame_NNNN.done starts with it, so
+/// --resume skips a frame only if the same fit and settings made it (a refitted fit, rerun by a
+/// workflow, renders its frames again).
+std::string frame_key(const EditJob& job) {
+    uint64_t h = 14695981039346656037ULL;
+    auto add = [&h](const std::string& text) {
+        for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+        h = (h ^ 0xffu) * 1099511628211ULL;  // a separator, so that ("ab", "c") differs from ("a", "bc")
+    };
+    for (const char* file : {"fit.json", "params.json", "refiner.pt"}) {
+        const fs::path p = fs::path(job.fitdir) / file;
+        add(fs::exists(p) ? read_file(p.string()) : std::string("absent"));
+    }
+    add(read_file(job.edits));
+    for (const auto& [key, value] : job.defines) add(key + "=" + value);
+    add(std::to_string(job.width) + "x" + std::to_string(job.height) + " spp " + std::to_string(job.spp) + " seed " +
+        std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp));
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "key %016llx", static_cast<unsigned long long>(h));
+    return buf;
+}
+
+/// The metrics row of a finished frame whose .done carries `key`; nullopt when it was made from
+/// another fit or settings (or before keys were written).
+std::optional<std::string> finished_row(const fs::path& done, const std::string& key) {
+    const std::string text = read_file(done.string());
+    const size_t eol = text.find('\n');
+    if (eol == std::string::npos || text.compare(0, eol, key) != 0) return std::nullopt;
+    return text.substr(eol + 1);
+}
+
 }  // namespace
 
 int render_edits(const EditJob& job, const Reporter& report) {
@@ -159,18 +192,23 @@ int render_edits(const EditJob& job, const Reporter& report) {
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
     if (job.frame_step < 1) throw std::invalid_argument("frame step must be at least 1");
     const int count = (last - first) / job.frame_step + 1;
+    const std::string key = frame_key(job);
+    bool told = false;
     for (int i = first; i <= last; i += job.frame_step) {
         char name[64];
         std::snprintf(name, sizeof name, "frame_%04d.done", i);
         const fs::path done = out / name;
-        std::string row;
+        std::optional<std::string> row;
         if (job.resume && fs::exists(done)) {
-            row = read_file(done.string());
-        } else {
-            row = render_frame(job, session, tools, i, w, h, out);
-            write_text_atomic(done.string(), row);
+            row = finished_row(done, key);
+            if (!row && !told) report.say(done.string() + " was made from another fit or settings: rendering again");
+            told = told || !row;
         }
-        if (job.reference) csv << row << "\n";
+        if (!row) {
+            row = render_frame(job, session, tools, i, w, h, out);
+            write_text_atomic(done.string(), key + "\n" + *row);
+        }
+        if (job.reference) csv << *row << "\n";
         StageProgress p;
         p.stage = "edit";
         p.step = (i - first) / job.frame_step + 1;

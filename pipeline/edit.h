@@ -27,7 +27,9 @@ struct EditJob {
     int first_frame = 0, last_frame = -1;
     int frame_step = 1;  ///< only every frame_step-th frame from first_frame (a stated subset)
     /// Skip frames an earlier (killed) run finished. Every frame ends by writing frame_NNNN.done
-    /// (its metrics row, or empty), atomically and last, so one there means the frame is whole.
+    /// (a key of the fit and settings, then its metrics row), atomically and last, so one there
+    /// means the frame is whole; one with another key (another fit, refiner or settings) is
+    /// rendered again.
     bool resume = false;
 };
 

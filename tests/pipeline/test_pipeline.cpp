@@ -64,6 +64,39 @@ TEST(Pipeline, CancelledFitWritesNoResultAndResumesToTheUninterruptedParameters)
     EXPECT_EQ(resumed.final_loss, whole.final_loss);
 }
 
+TEST(Pipeline, ResumeRefusesOrRestartsACheckpointOfOtherSettings) {
+    // A finished fit, rerun with another emission decay: --resume must not continue (finish at
+    // once with) the old parameters. Strict: an error naming settings.json and the setting;
+    // with restart_if_changed: the fit runs from the start and equals a fresh one.
+    const std::string dir = test::temp_dir("pipeline-fit-changed");
+    pipeline::FitJob job = small_fit(dir + "/fit");
+    pipeline::run_fit(job);
+    job.options.emission_decay = 0.5f;
+    job.resume = true;
+    try {
+        pipeline::run_fit(job);
+        ADD_FAILURE() << "resumed a checkpoint made with another emission decay";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("checkpoint/settings.json"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("emission_decay"), std::string::npos) << e.what();
+    }
+    job.restart_if_changed = true;
+    const pipeline::FitSummary restarted = pipeline::run_fit(job);
+    pipeline::FitJob fresh = small_fit(dir + "/fresh");
+    fresh.options.emission_decay = 0.5f;
+    pipeline::run_fit(fresh);
+    EXPECT_EQ(read_file(job.out + "/params.json"), read_file(fresh.out + "/params.json"))
+        << "the old fit was continued";
+    // The same settings again resume (nothing left to do) rather than restart.
+    const pipeline::FitSummary again = pipeline::run_fit(job);
+    EXPECT_EQ(again.state.history.size(), restarted.state.history.size());
+    EXPECT_EQ(read_file(job.out + "/params.json"), read_file(fresh.out + "/params.json"));
+    // --resume with no checkpoint at all is an error too.
+    pipeline::FitJob none = small_fit(dir + "/none");
+    none.resume = true;
+    EXPECT_THROW(pipeline::run_fit(none), std::runtime_error);
+}
+
 TEST(Pipeline, EditSequenceRendersEveryFrameOfTheFit) {
     const std::string dir = test::temp_dir("pipeline-edit");
     pipeline::run_fit(small_fit(dir + "/fit"));
@@ -86,6 +119,46 @@ TEST(Pipeline, EditSequenceRendersEveryFrameOfTheFit) {
         EXPECT_EQ(img.channels, 16);
         EXPECT_EQ(img.width, 8);
     }
+}
+
+TEST(Pipeline, ResumedEditsRenderAgainWhenTheFitChanged) {
+    // A workflow refits (another seed here) and reruns its edit job with --resume: the frames of
+    // the old fit must not be kept; the same fit again keeps them.
+    const std::string dir = test::temp_dir("pipeline-edit-refit");
+    pipeline::run_fit(small_fit(dir + "/fit"));
+    pipeline::EditJob edit;
+    edit.fitdir = dir + "/fit";
+    edit.edits = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/edits-demo.json";
+    edit.out = dir + "/edit";
+    edit.spp = 2;
+    edit.last_frame = 1;
+    edit.resume = true;
+    pipeline::render_edits(edit);
+    const std::string old_latent = read_file(edit.out + "/frame_0001_latent.exr");
+    pipeline::FitJob refit = small_fit(dir + "/fit");
+    refit.options.seed = 5;
+    pipeline::run_fit(refit);
+    std::vector<std::string> notes;
+    pipeline::Reporter r;
+    r.note = [&](const std::string& n) {
+        if (n.find("rendering again") != std::string::npos) notes.push_back(n);
+    };
+    pipeline::render_edits(edit, r);
+    ASSERT_EQ(notes.size(), 1u) << "one note naming the first stale frame";
+    EXPECT_NE(notes[0].find("frame_0000.done"), std::string::npos) << notes[0];
+    pipeline::EditJob fresh = edit;
+    fresh.out = dir + "/fresh";
+    fresh.resume = false;
+    pipeline::render_edits(fresh);
+    const std::string new_latent = read_file(edit.out + "/frame_0001_latent.exr");
+    EXPECT_NE(new_latent, old_latent) << "the refitted fit's frame was not rendered";
+    EXPECT_EQ(new_latent, read_file(fresh.out + "/frame_0001_latent.exr"));
+    // Nothing changed since: resume renders nothing (no note, the files stay).
+    fs::remove(edit.out + "/frame_0001_latent.exr");
+    notes.clear();
+    pipeline::render_edits(edit, r);
+    EXPECT_TRUE(notes.empty());
+    EXPECT_FALSE(fs::exists(edit.out + "/frame_0001_latent.exr")) << "a finished frame was rendered again";
 }
 
 // The in-memory session computes exactly what render --edit writes, frame for frame.
