@@ -160,7 +160,8 @@ def write_outputs(out, c, summary, failures, timings):
     md = ["# latentpt experiment summary", "",
           f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
           "reference spp per scene below, "
-          f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}), frames {frames or 'as in the edit files'}"
+          f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}), "
+          f"emission decay {c.get('emission_decay', 0):g}, frames {frames or 'as in the edit files'}"
           f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp", ""]
     for scene, s in summary.items():
         t = s["training_view"]
@@ -263,12 +264,14 @@ def write_outputs(out, c, summary, failures, timings):
 # paper's 3000 stage-1 iterations; no baseline fit (not in the paper's Table 1); convergence on
 # the training view only; the refiner 6000 steps with its learning rate decayed along a half cosine
 # (docs/results.md "Refiner study": 8 % lower edited LPIPS than 3000 constant-rate steps, ~3.3 min
-# more per scene).
+# more per scene); emission decay 1e-4 in every fit (docs/fitting.md (17); docs/results.md "Emission
+# decay": without it the +Ĩa fit's light walks to the parameter clamp and its 64-spp renders are noisy).
 PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
          "scene_res": {"cbox-specular": 1024, "veach-bidir": 512, "dining-room": 512},
          "frame_step": 15, "ref_spp": 512, "training_ref_spp": 512, "fit_iterations": 3000,
          "refiner_iterations": 6000, "refiner_lr_decay": "cosine", "fits": ["e", "ea", "eac"],
-         "spp_list": [1, 4, 16, 64, 256], "conv_views": ["training"], "equal_error_max_spp": 64}
+         "spp_list": [1, 4, 16, 64, 256], "conv_views": ["training"], "equal_error_max_spp": 64,
+         "emission_decay": 1e-4}
 
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
@@ -284,7 +287,7 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "scene_res": {} if image_res else p.get("scene_res", {}),
             "fit_iterations": fit_iterations or p.get("fit_iterations") or (300 if quick else 1500),
             "refiner_iterations": refiner_iterations or p.get("refiner_iterations") or (300 if quick else 3000),
-            "refiner_lr_decay": p.get("refiner_lr_decay", "none"),
+            "refiner_lr_decay": p.get("refiner_lr_decay", "none"), "emission_decay": p.get("emission_decay", 0),
             "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
             "ref_spp": ref_spp or p.get("ref_spp") or (32 if quick else None),
             "training_ref_spp": p.get("training_ref_spp"), "fits": p.get("fits", list(FITS)), "spp": spp,
@@ -355,9 +358,11 @@ def chunks(c, scene, kind):
     return [(f[i], f[min(i + k, len(f)) - 1]) for i in range(0, len(f), k)]
 
 
-def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refiner=None):
+def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refiner=None, decay=True):
     """`latentpt fit` arguments of one ablation fit into `out` (iterations: the config's;
-    refiner: None = as the fit's FITS entry says, False = stage 1 only)."""
+    refiner: None = as the fit's FITS entry says, False = stage 1 only; decay: pass the config's
+    emission decay; the training-reference job's fit is scratch, and without it its command, and
+    so its cached job, stay as they were)."""
     terms, extra, refine, lr = FITS[name]
     refine = refine if refiner is None else refiner
     its, res = c["fit_iterations"], image_res_of(c, scene)
@@ -374,6 +379,8 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
     # option, which have no key) stay as they were
     if refine and c.get("refiner_lr_decay", "none") != "none":
         cmd += ["--refiner-lr-decay", c["refiner_lr_decay"]]
+    if decay and c.get("emission_decay", 0):
+        cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     for define in SCENES[scene][1]:
         cmd += ["-D", define]
     return cmd
@@ -382,13 +389,17 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
 def fit_command(c, scene, name, threads):
     """`latentpt fit` of one ablation fit; --resume continues a killed one from its checkpoint."""
     d = os.path.join(scene, "fit_" + name)
-    return shlex.join(fit_argv(c, scene, name, threads, d)) + f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume)"
+    # --restart-if-changed: a rerun with changed parameters (Snakemake reruns the job) must not
+    # continue the old fit's checkpoint; a killed run of the same command continues it.
+    return shlex.join(fit_argv(c, scene, name, threads, d)) + \
+        f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume --restart-if-changed)"
 
 
 def training_reference_command(c, scene, threads):
     """A one-iteration fit without refiner whose job is to trace and encode the training view's
     reference into <scene>/refs once (its fit folder is scratch)."""
-    return shlex.join(fit_argv(c, scene, "e", threads, os.path.join(scene, "refs", "training_fit"), iterations=1, final_spp=1))
+    return shlex.join(fit_argv(c, scene, "e", threads, os.path.join(scene, "refs", "training_fit"), iterations=1, final_spp=1,
+                                decay=False))
 
 
 def edit_argv(binary, threads, fitdir, edits, out, spp, ref_spp, refs, frames=None):
