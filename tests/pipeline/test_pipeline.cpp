@@ -40,6 +40,17 @@ pipeline::RefineJob small_refine(const std::string& dir, int iterations) {
     return r;
 }
 
+/// A small fit in <dir>/fit and the demo edit sequence on it into <dir>/edit, at 2 spp.
+pipeline::EditJob demo_edit_of_a_small_fit(const std::string& dir) {
+    pipeline::run_fit(small_fit(dir + "/fit"));
+    pipeline::EditJob edit;
+    edit.fitdir = dir + "/fit";
+    edit.edits = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/edits-demo.json";
+    edit.out = dir + "/edit";
+    edit.spp = 2;
+    return edit;
+}
+
 pipeline::Reporter cancel_after(int step) {
     pipeline::Reporter r;
     r.progress = [step](const pipeline::StageProgress& p) { return p.step < step; };
@@ -99,12 +110,7 @@ TEST(Pipeline, ResumeRefusesOrRestartsACheckpointOfOtherSettings) {
 
 TEST(Pipeline, EditSequenceRendersEveryFrameOfTheFit) {
     const std::string dir = test::temp_dir("pipeline-edit");
-    pipeline::run_fit(small_fit(dir + "/fit"));
-    pipeline::EditJob edit;
-    edit.fitdir = dir + "/fit";
-    edit.edits = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/edits-demo.json";
-    edit.out = dir + "/edit";
-    edit.spp = 2;
+    pipeline::EditJob edit = demo_edit_of_a_small_fit(dir);
     int reported = 0;
     pipeline::Reporter r;
     r.progress = [&](const pipeline::StageProgress& p) {
@@ -125,12 +131,7 @@ TEST(Pipeline, ResumedEditsRenderAgainWhenTheFitChanged) {
     // A workflow refits (another seed here) and reruns its edit job with --resume: the frames of
     // the old fit must not be kept; the same fit again keeps them.
     const std::string dir = test::temp_dir("pipeline-edit-refit");
-    pipeline::run_fit(small_fit(dir + "/fit"));
-    pipeline::EditJob edit;
-    edit.fitdir = dir + "/fit";
-    edit.edits = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/edits-demo.json";
-    edit.out = dir + "/edit";
-    edit.spp = 2;
+    pipeline::EditJob edit = demo_edit_of_a_small_fit(dir);
     edit.last_frame = 1;
     edit.resume = true;
     pipeline::render_edits(edit);
