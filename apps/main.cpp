@@ -336,7 +336,11 @@ struct Cli {
         add_refine_options(refine, rf.job, "");
         refine->add_option("--seed", rf.job.train.seed, "seed of the initial weights, crops and dropout")
             ->capture_default_str();
-        refine->add_flag("--resume", rf.job.resume, "continue from <fitdir>/refiner_checkpoint.pt");
+        refine->add_flag("--resume", rf.job.resume,
+                         "continue from <fitdir>/refiner_checkpoint.pt; one trained with other settings is an error");
+        refine->add_flag("--restart-if-changed", rf.job.restart_if_changed,
+                         "with --resume: a checkpoint trained with other settings is removed and training starts "
+                         "again");
         refine->add_flag("-q,--quiet", rf.quiet, "no progress line");
     }
 

@@ -220,6 +220,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
         r.fitdir = job.out;
         r.train.seed = job.options.seed;
         r.resume = resume;  // a stage 1 started again makes the old refiner checkpoint stale too
+        r.restart_if_changed = job.restart_if_changed;
         summary.refined = run_refine(r, report);
     }
     return summary;

@@ -45,26 +45,69 @@ std::string settings_difference(const nlohmann::json& recorded, const nlohmann::
     return "";
 }
 
+namespace {
+
+/// Whether the checkpoint recorded in `file` may be resumed with `settings`; "" or why not.
+std::string why_not_resumable(const fs::path& file, const nlohmann::json& settings) {
+    if (!fs::exists(file)) return "it records no settings (made before they were recorded)";
+    try {
+        return settings_difference(nlohmann::json::parse(read_file(file.string())), settings);
+    } catch (const nlohmann::json::exception& e) {
+        return std::string("it is not JSON: ") + e.what();
+    }
+}
+
+/// The shared rule: resume only a checkpoint of the same settings; another one is an error, or
+/// removed with restart_if_changed. Returns whether to resume.
+bool keep_checkpoint(const fs::path& settings_file, const nlohmann::json& settings, bool resume, bool restart,
+                     const std::string& none_why) {
+    if (!resume) return false;
+    const std::string why = none_why.empty() ? why_not_resumable(settings_file, settings) : none_why;
+    if (!why.empty() && !restart)
+        throw std::runtime_error(settings_file.string() + ": cannot resume this checkpoint: " + why +
+                                 "; run without --resume to start again");
+    return why.empty();
+}
+
+}  // namespace
+
 bool prepare_checkpoint(const std::string& dir, const nlohmann::json& settings, bool resume, bool restart_if_changed) {
     const fs::path file = fs::path(dir) / "settings.json";
-    bool keep = resume;
-    if (resume) {
-        std::string why = "it records no settings (made before they were recorded)";
-        if (!fs::exists(fs::path(dir) / "state.json")) why = "there is none";
-        else if (fs::exists(file)) {
-            try {
-                why = settings_difference(nlohmann::json::parse(read_file(file.string())), settings);
-            } catch (const nlohmann::json::exception& e) {
-                why = std::string("it is not JSON: ") + e.what();
-            }
-        }
-        if (!why.empty() && !restart_if_changed)
-            throw std::runtime_error(file.string() + ": cannot resume this checkpoint: " + why +
-                                     "; run without --resume to start again");
-        keep = why.empty();
-    }
+    const bool none = !fs::exists(fs::path(dir) / "state.json");
+    const bool keep = keep_checkpoint(file, settings, resume, restart_if_changed, none ? "there is none" : "");
     if (!keep) fs::remove_all(dir);
     fs::create_directories(dir);
+    write_text_atomic(file.string(), settings.dump(1));
+    return keep;
+}
+
+nlohmann::json stage2_settings(const RefineJob& job) {
+    const RefinerTrainOptions& t = job.train;
+    return {{"fitdir", fs::absolute(job.fitdir).string()},
+            {"expansion", job.net.expansion},
+            {"squash", job.net.squash},
+            {"dropout", job.net.dropout},
+            {"norm", job.net.instance_norm ? "instance" : "none"},
+            {"iterations", t.iterations},
+            {"lr", t.lr},
+            {"lr_decay", t.cosine_decay ? "cosine" : "none"},
+            {"w_mse", t.w_mse},
+            {"w_ssim", t.w_ssim},
+            {"w_lpips", t.w_lpips},
+            {"crop", t.crop},
+            {"lpips_crop", t.lpips_crop},
+            {"patience", t.patience},
+            {"min_delta", t.min_delta},
+            {"seed", t.seed},
+            {"noise_views", job.noise_views},
+            {"augment", to_string(job.augment)}};
+}
+
+bool prepare_refiner_checkpoint(const std::string& checkpoint_path, const nlohmann::json& settings, bool resume,
+                                bool restart_if_changed) {
+    const fs::path file = fs::path(checkpoint_path).replace_extension(".json");
+    const bool keep = keep_checkpoint(file, settings, resume, restart_if_changed, "");
+    if (!keep) fs::remove(checkpoint_path);
     write_text_atomic(file.string(), settings.dump(1));
     return keep;
 }

@@ -1,8 +1,10 @@
-// Which stage-1 checkpoint a `fit --resume` may continue: the checkpoint folder records the
-// settings that shape the result (scene, target, model, optimiser), and a resumed fit checks them,
-// so a fit rerun with a changed setting never silently continues the old one's parameters.
+// Which checkpoint a `--resume` may continue: a stage-1 checkpoint folder and a refiner
+// checkpoint record the settings that shape their result (scene, target, model, optimiser,
+// network), and a resumed run checks them, so a run with a changed setting never silently
+// continues the old one's state.
 #pragma once
 #include "pipeline/fit.h"
+#include "pipeline/refine.h"
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -23,5 +25,15 @@ std::string settings_difference(const nlohmann::json& recorded, const nlohmann::
 /// The settings are written before any new checkpoint, atomically.
 bool prepare_checkpoint(const std::string& checkpoint_dir, const nlohmann::json& settings, bool resume,
                         bool restart_if_changed);
+
+/// What determines stage 2's weights: the network, the training options and the training views
+/// (not checkpoint_every, the inference window or where LPIPS weights live).
+nlohmann::json stage2_settings(const RefineJob& job);
+
+/// As prepare_checkpoint for the refiner's one-file checkpoint, whose settings live beside it in
+/// <checkpoint>.json (refiner_checkpoint.json). `resume` is true only when the checkpoint exists;
+/// without resuming, the old checkpoint is removed.
+bool prepare_refiner_checkpoint(const std::string& checkpoint_path, const nlohmann::json& settings, bool resume,
+                                bool restart_if_changed);
 
 }  // namespace lpt::pipeline

@@ -3,6 +3,7 @@
 #include "core/image_io.h"
 #include "core/sampler.h"
 #include "latent/latent.h"
+#include "pipeline/fit_checkpoint.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/output_lock.h"
 #include "pipeline/paths.h"
@@ -230,7 +231,8 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     auto refiner = Refiner::create(cfg, job.train.seed);
     RefinerTrainOptions o = job.train;
     o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();
-    o.resume = job.resume && fs::exists(o.checkpoint_path);
+    o.resume = prepare_refiner_checkpoint(o.checkpoint_path, stage2_settings(job),
+                                          job.resume && fs::exists(o.checkpoint_path), job.restart_if_changed);
     bool cancelled = false;
     std::set<std::string> reported;  // once per weight
     auto on_iteration = [&](const RefinerRecord& r) {

@@ -24,7 +24,10 @@ struct RefineJob {
     /// Apply the trained refiner on windows the size of its training crop (RefinerConfig::tile)
     /// when InstanceNorm is on and the crop is smaller than the view; false: the whole view at once.
     bool windowed_inference = true;
-    bool resume = false;    ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
+    bool resume = false;  ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
+    /// With resume: a checkpoint trained with other settings (refiner_checkpoint.json) is removed
+    /// and training starts again, instead of an error (pipeline/fit_checkpoint.h).
+    bool restart_if_changed = false;
     std::string lpips_dir;  ///< empty = ../shared/models/lpips
 };
 

@@ -82,6 +82,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "checkpoint_every") t.checkpoint_every = value.cast<int>();
     else if (k == "lpips_dir") job.lpips_dir = value.cast<std::string>();
     else if (k == "seed") t.seed = value.cast<uint64_t>();
+    else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
     else return false;
     return true;
 }

@@ -232,3 +232,33 @@ TEST(Pipeline, RefinerAugmentationNeedsThePathTracedReference) {
         EXPECT_NE(std::string(e.what()).find("--refiner-augment mirror"), std::string::npos) << e.what();
     }
 }
+
+TEST(Pipeline, RefinerResumeRefusesOrRestartsACheckpointOfOtherSettings) {
+    // A finished refiner, resumed with more iterations (another cosine curve): an error naming
+    // refiner_checkpoint.json and the setting; with restart_if_changed a fresh training, equal
+    // to one from scratch.
+    pipeline::RefineJob r = small_refine(test::temp_dir("pipeline-refine-changed"), 6);
+    r.train.patience = 0;
+    pipeline::run_refine(r);
+    r.train.iterations = 8;
+    r.resume = true;
+    try {
+        pipeline::run_refine(r);
+        ADD_FAILURE() << "resumed a refiner checkpoint trained for another iteration count";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("refiner_checkpoint.json"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("iterations"), std::string::npos) << e.what();
+    }
+    r.restart_if_changed = true;
+    const pipeline::RefineSummary restarted = pipeline::run_refine(r);
+    pipeline::RefineJob fresh = r;
+    fresh.resume = false;
+    const pipeline::RefineSummary scratch = pipeline::run_refine(fresh);
+    ASSERT_EQ(restarted.result.history.size(), 8u);
+    ASSERT_EQ(scratch.result.history.size(), 8u);
+    EXPECT_EQ(restarted.result.history.back().loss, scratch.result.history.back().loss);
+    // The same settings resume: nothing is left to train.
+    const pipeline::RefineSummary again = pipeline::run_refine(r);
+    EXPECT_EQ(again.result.history.size(), 8u);
+    EXPECT_EQ(again.result.history.back().loss, scratch.result.history.back().loss);
+}
