@@ -29,7 +29,8 @@ def stage1_fit(c, scene, name, seed, out, log):
         return os.path.join(scene, "fit_" + name)
     if not os.path.exists(os.path.join(out, "fit.json")):
         argv = X.fit_argv(c, scene, name, os.cpu_count(), out, refiner=False) + ["--seed", str(seed)]
-        X.run_logged(argv + (["--resume"] if os.path.isdir(os.path.join(out, "checkpoint")) else []), log, "seed_spread")
+        resume = ["--resume", "--restart-if-changed"] if os.path.isdir(os.path.join(out, "checkpoint")) else []
+        X.run_logged(argv + resume, log, "seed_spread")
     return out
 
 
