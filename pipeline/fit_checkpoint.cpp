@@ -83,12 +83,13 @@ bool prepare_checkpoint(const std::string& dir, const nlohmann::json& settings, 
 
 nlohmann::json stage2_settings(const RefineJob& job) {
     const RefinerTrainOptions& t = job.train;
-    return {{"fitdir", fs::absolute(job.fitdir).string()},
+    // At a constant rate the iteration count only says where to stop, so a finished training
+    // may be extended with --resume; along the cosine it shapes every step's rate.
+    nlohmann::json s = {{"fitdir", fs::absolute(job.fitdir).string()},
             {"expansion", job.net.expansion},
             {"squash", job.net.squash},
             {"dropout", job.net.dropout},
             {"norm", job.net.instance_norm ? "instance" : "none"},
-            {"iterations", t.iterations},
             {"lr", t.lr},
             {"lr_decay", t.cosine_decay ? "cosine" : "none"},
             {"w_mse", t.w_mse},
@@ -101,6 +102,8 @@ nlohmann::json stage2_settings(const RefineJob& job) {
             {"seed", t.seed},
             {"noise_views", job.noise_views},
             {"augment", to_string(job.augment)}};
+    if (t.cosine_decay) s["iterations"] = t.iterations;
+    return s;
 }
 
 bool prepare_refiner_checkpoint(const std::string& checkpoint_path, const nlohmann::json& settings, bool resume,

@@ -27,7 +27,8 @@ bool prepare_checkpoint(const std::string& checkpoint_dir, const nlohmann::json&
                         bool restart_if_changed);
 
 /// What determines stage 2's weights: the network, the training options and the training views
-/// (not checkpoint_every, the inference window or where LPIPS weights live).
+/// (not checkpoint_every, the inference window or where LPIPS weights live; the iteration count
+/// only with the cosine decay, which it shapes).
 nlohmann::json stage2_settings(const RefineJob& job);
 
 /// As prepare_checkpoint for the refiner's one-file checkpoint, whose settings live beside it in

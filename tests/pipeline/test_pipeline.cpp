@@ -234,11 +234,12 @@ TEST(Pipeline, RefinerAugmentationNeedsThePathTracedReference) {
 }
 
 TEST(Pipeline, RefinerResumeRefusesOrRestartsACheckpointOfOtherSettings) {
-    // A finished refiner, resumed with more iterations (another cosine curve): an error naming
-    // refiner_checkpoint.json and the setting; with restart_if_changed a fresh training, equal
-    // to one from scratch.
+    // A finished refiner on the cosine, resumed with more iterations (another curve): an error
+    // naming refiner_checkpoint.json and the setting; with restart_if_changed a fresh training,
+    // equal to one from scratch. (At a constant rate more iterations extend it: tests/cli.)
     pipeline::RefineJob r = small_refine(test::temp_dir("pipeline-refine-changed"), 6);
     r.train.patience = 0;
+    r.train.cosine_decay = true;
     pipeline::run_refine(r);
     r.train.iterations = 8;
     r.resume = true;
