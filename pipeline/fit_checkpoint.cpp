@@ -86,22 +86,22 @@ nlohmann::json stage2_settings(const RefineJob& job) {
     // At a constant rate the iteration count only says where to stop, so a finished training
     // may be extended with --resume; along the cosine it shapes every step's rate.
     nlohmann::json s = {{"fitdir", fs::absolute(job.fitdir).string()},
-            {"expansion", job.net.expansion},
-            {"squash", job.net.squash},
-            {"dropout", job.net.dropout},
-            {"norm", job.net.instance_norm ? "instance" : "none"},
-            {"lr", t.lr},
-            {"lr_decay", t.cosine_decay ? "cosine" : "none"},
-            {"w_mse", t.w_mse},
-            {"w_ssim", t.w_ssim},
-            {"w_lpips", t.w_lpips},
-            {"crop", t.crop},
-            {"lpips_crop", t.lpips_crop},
-            {"patience", t.patience},
-            {"min_delta", t.min_delta},
-            {"seed", t.seed},
-            {"noise_views", job.noise_views},
-            {"augment", to_string(job.augment)}};
+                        {"expansion", job.net.expansion},
+                        {"squash", job.net.squash},
+                        {"dropout", job.net.dropout},
+                        {"norm", job.net.instance_norm ? "instance" : "none"},
+                        {"lr", t.lr},
+                        {"lr_decay", t.cosine_decay ? "cosine" : "none"},
+                        {"w_mse", t.w_mse},
+                        {"w_ssim", t.w_ssim},
+                        {"w_lpips", t.w_lpips},
+                        {"crop", t.crop},
+                        {"lpips_crop", t.lpips_crop},
+                        {"patience", t.patience},
+                        {"min_delta", t.min_delta},
+                        {"seed", t.seed},
+                        {"noise_views", job.noise_views},
+                        {"augment", to_string(job.augment)}};
     if (t.cosine_decay) s["iterations"] = t.iterations;
     return s;
 }
