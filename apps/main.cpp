@@ -241,6 +241,12 @@ struct Cli {
                         "(docs/fitting.md (17))")
             ->capture_default_str()
             ->check(non_negative());
+        fit->add_option(
+               "--emitter-response-decay", f.job.options.emitter_response_decay,
+               "mu of the L2 penalty mu * sum (La^2 + Lc^2) on the flat and occlusion responses of every emitting "
+               "shape; 0 = off (docs/fitting.md (18))")
+            ->capture_default_str()
+            ->check(non_negative());
     }
 
     /// The optimiser, the target's RGB reference, the VAE, stage 2: the rest of fit's options.

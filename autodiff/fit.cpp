@@ -63,19 +63,37 @@ void record_kept_parameters(FitState& state, const EarlyStopping& stopper, int p
     state.best_iteration = stopper.best_iteration();
 }
 
+/// Adds λ·Σ v² over slice k's values to `penalty` and 2λ·v to their gradients.
+void add_square_penalty(ParamStore& ps, int k, float lambda, double& penalty) {
+    const float* v = ps.value(k);
+    float* g = ps.grad_value(k);
+    for (int c = 0; c < ps.slice(k).channels; ++c) {
+        penalty += double(lambda) * v[c] * v[c];
+        g[c] += 2.f * lambda * v[c];
+    }
+}
+
 }  // namespace
 
 double add_emission_decay(ParamStore& ps, float lambda) {
     if (lambda == 0.f) return 0.0;
     double penalty = 0.0;
+    for (size_t k = 0; k < ps.slice_count(); ++k)
+        if (ps.slice(int(k)).kind == "Le") add_square_penalty(ps, int(k), lambda, penalty);
+    return penalty;
+}
+
+double add_emitter_response_decay(ParamStore& ps, float lambda) {
+    if (lambda == 0.f) return 0.0;
+    double penalty = 0.0;
     for (size_t k = 0; k < ps.slice_count(); ++k) {
         const ParamSlice& sl = ps.slice(int(k));
         if (sl.kind != "Le") continue;
-        const float* v = ps.value(int(k));
-        float* g = ps.grad_value(int(k));
-        for (int c = 0; c < sl.channels; ++c) {
-            penalty += double(lambda) * v[c] * v[c];
-            g[c] += 2.f * lambda * v[c];
+        // "<shape id>.Le" -> "<shape id>.La", ".Lc"; the environment has neither
+        const std::string shape = sl.name.substr(0, sl.name.size() - 2);
+        for (const char* response : {"La", "Lc"}) {
+            const int r = ps.find(shape + response);
+            if (r >= 0) add_square_penalty(ps, r, lambda, penalty);
         }
     }
     return penalty;
@@ -127,7 +145,7 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         ps.zero_grad();
         if (K == 0) backward_latent(model, ro, d_image);
         else replay_backward(model, *records, d_image);
-        loss += add_emission_decay(ps, o.emission_decay);
+        loss += add_emission_decay(ps, o.emission_decay) + add_emitter_response_decay(ps, o.emitter_response_decay);
         ps.backward();
         const float lr = schedule.lr_at(it);
         size_t bad = adam.step(ps.raw().data(), ps.grad_raw().data(), ps.raw().size(), lr);

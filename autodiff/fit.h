@@ -23,6 +23,11 @@ struct FitOptions {
     /// With the flat term, a light's L̃e + L̃a is all its own pixels see, so the loss alone leaves
     /// L̃e free to grow along that valley (and its indirect noise with it).
     float emission_decay = 0.f;
+    /// μ of the penalty μ·Σ (L̃a² + L̃c²) on the flat and occlusion responses of every emitting
+    /// shape (docs/fitting.md (18)); 0 = off. Closes the same valley from the other side: on a
+    /// light's own pixels both act as flat terms beside L̃e; pinned near 0, those pixels fix L̃e
+    /// without pulling down an L̃e that the room's light needs.
+    float emitter_response_decay = 0.f;
     ToneCurve tone = ToneCurve::Clip;
     int patience = 300;  ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
@@ -62,6 +67,11 @@ struct FitState {
 /// Emission decay: the penalty λ·Σ L̃e² over every "Le" slice (docs/fitting.md (17)): adds its
 /// derivative 2λ·L̃e to the value gradients (before ParamStore::backward) and returns its value.
 double add_emission_decay(ParamStore& params, float lambda);
+
+/// Emitter response decay: the penalty μ·Σ (L̃a² + L̃c²) over the "La" and "Lc" slices of every
+/// shape that has an "Le" slice (docs/fitting.md (18)); gradients and return value as
+/// add_emission_decay.
+double add_emitter_response_decay(ParamStore& params, float mu);
 
 /// Latent render with the fit's tone curve applied: what the loss compares with the target.
 std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone);

@@ -178,9 +178,11 @@ void validate(const FitJob& job) {
         throw std::invalid_argument("--gate is shadowed or visible, got '" + job.gate + "'");
     if (job.ref_tone != "clip" && job.ref_tone != "reinhard")
         throw std::invalid_argument("--ref-tone is clip or reinhard, got '" + job.ref_tone + "'");
-    if (!(job.options.emission_decay >= 0.f) || !std::isfinite(job.options.emission_decay))
-        throw std::invalid_argument("--emission-decay must be a finite number >= 0, got " +
-                                    std::to_string(job.options.emission_decay));
+    for (const auto& [flag, value] : {std::pair{"--emission-decay", job.options.emission_decay},
+                                      std::pair{"--emitter-response-decay", job.options.emitter_response_decay}})
+        if (!(value >= 0.f) || !std::isfinite(value))
+            throw std::invalid_argument(std::string(flag) + " must be a finite number >= 0, got " +
+                                        std::to_string(value));
     if (job.refiner) validate(job.refine);
 }
 

@@ -29,6 +29,7 @@ nlohmann::json stage1_settings(const FitJob& job) {
             {"lr_t_mult", o.lr_t_mult},
             {"huber_delta", o.huber_delta},
             {"emission_decay", o.emission_decay},
+            {"emitter_response_decay", o.emitter_response_decay},
             {"tone", to_string(o.tone)},
             {"patience", o.patience},
             {"min_delta", o.min_delta},
@@ -36,11 +37,25 @@ nlohmann::json stage1_settings(const FitJob& job) {
             {"reuse_paths", o.reuse_paths}};
 }
 
+namespace {
+
+/// Settings added after checkpoints began to record theirs, with the value every checkpoint
+/// made before them had: one without the key resumes when the setting still has that value.
+const nlohmann::json& settings_added_later() {
+    static const nlohmann::json added = {{"emitter_response_decay", 0.0}};
+    return added;
+}
+
+}  // namespace
+
 std::string settings_difference(const nlohmann::json& recorded, const nlohmann::json& wanted) {
+    const nlohmann::json& added = settings_added_later();
     for (const auto& [key, value] : wanted.items()) {
-        if (!recorded.contains(key)) return "it records no '" + key + "'";
-        if (recorded[key] != value)
-            return "it was made with " + key + " = " + recorded[key].dump() + ", this fit has " + value.dump();
+        const bool has = recorded.contains(key);
+        if (!has && !added.contains(key)) return "it records no '" + key + "'";
+        const nlohmann::json& made_with = has ? recorded[key] : added[key];
+        if (made_with != value)
+            return "it was made with " + key + " = " + made_with.dump() + ", this fit has " + value.dump();
     }
     return "";
 }

@@ -15,7 +15,8 @@ namespace lpt::pipeline {
 nlohmann::json stage1_settings(const FitJob& job);
 
 /// "" when `recorded` (a checkpoint's settings.json) equals `wanted`; otherwise one sentence
-/// naming the first setting that differs, with both values.
+/// naming the first setting that differs, with both values. A setting added after checkpoints
+/// began recording theirs (emitter_response_decay) that `recorded` lacks counts as its old value.
 std::string settings_difference(const nlohmann::json& recorded, const nlohmann::json& wanted);
 
 /// Prepares <checkpoint_dir> for a fit with `settings` and returns whether to resume from it:

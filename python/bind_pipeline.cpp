@@ -100,6 +100,7 @@ void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
         else if (k == "lr_period") o.lr_period = value.cast<int>();
         else if (k == "patience") o.patience = value.cast<int>();
         else if (k == "emission_decay") o.emission_decay = value.cast<float>();
+        else if (k == "emitter_response_decay") o.emitter_response_decay = value.cast<float>();
         else if (k == "reuse_paths") o.reuse_paths = value.cast<int>();
         else if (k == "checkpoint_every") o.checkpoint_every = value.cast<int>();
         else if (k == "tone") o.tone = parse_tone_curve(value.cast<std::string>());

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 
 using namespace lpt;
@@ -169,20 +170,23 @@ TEST(Fit, NonFiniteStepsAreRefusedNamedAndLeaveTheParameters) {
     EXPECT_EQ(m.params().raw(), raw_before);
 }
 
-TEST(EmissionDecay, GradientMatchesCentralDifferencesInBothParameterisations) {
-    // The penalty's raw gradient (value gradient mapped by ParamStore::backward) against central
-    // differences of the penalty itself, for the identity and the pos − neg maps.
+namespace {
+
+/// A penalty's raw gradient (value gradient mapped by ParamStore::backward) against central
+/// differences of the penalty itself, for the identity and the pos − neg maps; the slices
+/// `penalised` names must have gradients, all others none.
+void expect_penalty_gradient_matches_differences(const std::function<double(ParamStore&)>& penalty,
+                                                 const std::function<bool(const ParamSlice&)>& penalised) {
     for (Parameterisation p : {Parameterisation::Code, Parameterisation::Paper}) {
         Scene scene = cornell();
         LatentModel m(scene, p, 3);
         ParamStore& ps = m.params();
-        const float lambda = 0.3f;
         ps.zero_grad();
-        const double at = add_emission_decay(ps, lambda);
+        const double at = penalty(ps);
         ps.backward();
         const std::vector<float> grad = ps.grad_raw();
         EXPECT_GT(at, 0.0);
-        int checked = 0, le_entries = 0;
+        int checked = 0, penalised_entries = 0;
         for (size_t k = 0; k < ps.slice_count(); ++k) {
             const ParamSlice& sl = ps.slice(int(k));
             for (size_t r = sl.raw_offset; r < sl.raw_offset + sl.raw_size(); ++r) {
@@ -191,48 +195,87 @@ TEST(EmissionDecay, GradientMatchesCentralDifferencesInBothParameterisations) {
                     ps.raw()[r] = x;
                     ps.update_values();
                     ps.zero_grad();
-                    return add_emission_decay(ps, lambda);
+                    return penalty(ps);
                 };
                 const double fd = (penalty_at(keep + h) - penalty_at(keep - h)) / (2 * h);
                 penalty_at(keep);
                 // Quadratic in the values, values affine in raw for these maps: exact up to rounding.
                 EXPECT_NEAR(grad[r], fd, 1e-4 + 1e-3 * std::abs(fd)) << sl.name << " raw " << r - sl.raw_offset;
-                if (sl.kind == "Le") ++le_entries;
-                else EXPECT_EQ(grad[r], 0.f) << sl.name;  // only the emission is penalised
+                if (penalised(sl)) ++penalised_entries;
+                else EXPECT_EQ(grad[r], 0.f) << sl.name;
                 ++checked;
             }
         }
-        EXPECT_GT(le_entries, 0);
+        EXPECT_GT(penalised_entries, 0);
         EXPECT_EQ(size_t(checked), ps.raw().size());
     }
 }
 
-TEST(EmissionDecay, PullsTheLightOutOfTheFlatTermsValley) {
-    // With the flat term on, the light's own pixels see L̃e + L̃a only; the penalty must shrink
-    // |L̃e| (the part that also lights the room, with the room's noise) at little cost in loss.
+}  // namespace
+
+TEST(EmissionDecay, GradientMatchesCentralDifferencesInBothParameterisations) {
+    expect_penalty_gradient_matches_differences([](ParamStore& ps) { return add_emission_decay(ps, 0.3f); },
+                                                [](const ParamSlice& sl) { return sl.kind == "Le"; });
+}
+
+TEST(EmitterResponseDecay, GradientMatchesCentralDifferencesOnTheLightsResponsesOnly) {
+    // The Cornell box's one emitting shape is "light": its La and Lc are penalised, no other
+    // shape's (the walls' responses are what carries them) and no Le.
+    expect_penalty_gradient_matches_differences(
+        [](ParamStore& ps) { return add_emitter_response_decay(ps, 0.3f); },
+        [](const ParamSlice& sl) { return sl.name == "light.La" || sl.name == "light.Lc"; });
+}
+
+namespace {
+
+struct DecayedFit {
+    double le2 = 0, light_responses2 = 0, loss = 0;  ///< Σ L̃e², Σ (L̃a² + L̃c²) of the light, loss at 4 spp
+};
+
+/// A 300-iteration fit of all three terms, to a target rendered by another random model.
+DecayedFit fit_with_decay(float emission_decay, float emitter_response_decay) {
     Scene ts = cornell();
     LatentModel truth(ts, Parameterisation::Code, 1);
     const std::vector<float> target = render_toned(truth, target_options(ts, 256, 99), ToneCurve::Clip);
-    auto fit = [&](float lambda) {
-        Scene scene = cornell();
-        LatentModel m(scene, Parameterisation::Code, 2);
-        m.terms().ambient = true;
-        FitOptions fo = fit_options(300);
-        fo.emission_decay = lambda;
-        fit_latent(m, target, kRes, kRes, fo);
-        double le2 = 0, loss = 0;
-        for (size_t k = 0; k < m.params().slice_count(); ++k)
-            if (m.params().slice(int(k)).kind == "Le")
-                for (int c = 0; c < kLatentChannels; ++c) le2 += std::pow(m.params().value(int(k))[c], 2.0);
-        for (uint64_t s = 0; s < 8; ++s) {
-            auto img = render_toned(m, target_options(scene, 4, 3000 + s), ToneCurve::Clip);
-            loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
+    Scene scene = cornell();
+    LatentModel m(scene, Parameterisation::Code, 2);
+    m.terms().ambient = true;
+    FitOptions fo = fit_options(300);
+    fo.emission_decay = emission_decay;
+    fo.emitter_response_decay = emitter_response_decay;
+    fit_latent(m, target, kRes, kRes, fo);
+    DecayedFit r;
+    const ParamStore& ps = m.params();
+    for (size_t k = 0; k < ps.slice_count(); ++k)
+        for (int c = 0; c < kLatentChannels; ++c) {
+            const double v2 = std::pow(ps.value(int(k))[c], 2.0);
+            if (ps.slice(int(k)).kind == "Le") r.le2 += v2;
+            if (ps.slice(int(k)).name == "light.La" || ps.slice(int(k)).name == "light.Lc") r.light_responses2 += v2;
         }
-        std::cout << "emission decay " << lambda << ": sum Le^2 " << le2 << ", loss " << loss << "\n";
-        return std::pair{le2, loss};
-    };
-    auto [le2_free, loss_free] = fit(0.f);
-    auto [le2_decayed, loss_decayed] = fit(1e-3f);
-    EXPECT_LT(le2_decayed, 0.5 * le2_free);
-    EXPECT_LT(loss_decayed, 1.5 * loss_free);
+    for (uint64_t s = 0; s < 8; ++s) {
+        auto img = render_toned(m, target_options(scene, 4, 3000 + s), ToneCurve::Clip);
+        r.loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
+    }
+    std::cout << "decays " << emission_decay << ", " << emitter_response_decay << ": sum Le^2 " << r.le2
+              << ", light La^2 + Lc^2 " << r.light_responses2 << ", loss " << r.loss << "\n";
+    return r;
+}
+
+}  // namespace
+
+TEST(EmissionDecay, PullsTheLightOutOfTheFlatTermsValley) {
+    // With the flat term on, the light's own pixels see L̃e + L̃a only; the penalty must shrink
+    // |L̃e| (the part that also lights the room, with the room's noise) at little cost in loss.
+    const DecayedFit free = fit_with_decay(0.f, 0.f), decayed = fit_with_decay(1e-3f, 0.f);
+    EXPECT_LT(decayed.le2, 0.5 * free.le2);
+    EXPECT_LT(decayed.loss, 1.5 * free.loss);
+}
+
+TEST(EmitterResponseDecay, PinsTheLightsResponsesNotItsEmission) {
+    // The same valley closed from the other side: the light's L̃a and L̃c go to ~0, so its own
+    // pixels fix L̃e, which the penalty leaves alone (unlike the emission decay, it may stay large).
+    const DecayedFit free = fit_with_decay(0.f, 0.f), pinned = fit_with_decay(0.f, 1e-3f);
+    EXPECT_LT(pinned.light_responses2, 0.25 * free.light_responses2);
+    EXPECT_GT(pinned.le2, 0.5 * free.le2);
+    EXPECT_LT(pinned.loss, 1.5 * free.loss);
 }

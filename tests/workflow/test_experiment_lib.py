@@ -38,6 +38,11 @@ class Preset(unittest.TestCase):
             self.assertIn("--emission-decay 0.0001", X.fit_command(c, "cbox-specular", fit, 2))
             self.assertIn("--resume --restart-if-changed", X.fit_command(c, "cbox-specular", fit, 2))
         self.assertNotIn("--emission-decay", X.fit_command(X.settings(), "cbox-specular", "ea", 2))
+        self.assertNotIn("--emitter-response-decay", X.fit_command(c, "cbox-specular", "ea", 2))
+        # the decays as flags: an explicit value overrides the preset's, 0 drops the option
+        c = X.settings(paper=True, emission_decay=0, emitter_response_decay=1e-4)
+        self.assertNotIn("--emission-decay", X.fit_command(c, "cbox-specular", "ea", 2))
+        self.assertIn("--emitter-response-decay 0.0001", X.fit_command(c, "cbox-specular", "ea", 2))
         c = X.settings(paper=True, image_res=256, frame_step=2, fit_iterations=10)
         self.assertEqual(X.image_res_of(c, "cbox-specular"), 256)
         self.assertEqual((c["frame_step"], c["fit_iterations"]), (2, 10))
