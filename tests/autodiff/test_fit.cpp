@@ -247,7 +247,7 @@ DecayedFit fit_with_decay(float emission_decay, float emitter_response_decay) {
     DecayedFit r;
     const ParamStore& ps = m.params();
     for (size_t k = 0; k < ps.slice_count(); ++k)
-        for (int c = 0; c < kLatentChannels; ++c) {
+        for (int c = 0; c < ps.slice(int(k)).channels; ++c) {  // scalar slices have one value
             const double v2 = std::pow(ps.value(int(k))[c], 2.0);
             if (ps.slice(int(k)).kind == "Le") r.le2 += v2;
             if (ps.slice(int(k)).name == "light.La" || ps.slice(int(k)).name == "light.Lc") r.light_responses2 += v2;
