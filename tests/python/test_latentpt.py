@@ -135,17 +135,25 @@ class GuidanceTest(unittest.TestCase):
         mask_t = torch.from_numpy(mask)
         raw = lt.raw_parameters(m)
         start = raw.detach().clone()
+
+        def guide_loss(r, spp, seed):
+            return ((lt.render_latent(m, r, spp=spp, seed=seed) - target)[mask_t] ** 2).mean()
+
+        # Judged on one 64-spp render with fixed random numbers before and after: the 4-spp losses
+        # of the loop itself are too noisy to compare a few steps of.
+        with torch.no_grad():
+            before_loss = float(guide_loss(start, 64, 12345))
         # Plain gradient steps: Adam would move every parameter with any gradient at the same rate.
-        opt = torch.optim.SGD([raw], lr=0.5)
-        losses = []
+        # lr 0.1: at 0.5 the loop overshoots and its loss climbs back (3.6 -> 0.65 -> 1.8).
+        opt = torch.optim.SGD([raw], lr=0.1)
         for it in range(30):
             opt.zero_grad()
-            latent = lt.render_latent(m, raw, spp=4, seed=it)
-            loss = ((latent - target)[mask_t] ** 2).mean()
-            loss.backward()
+            guide_loss(raw, 4, it).backward()
             opt.step()
-            losses.append(float(loss))
-        self.assertLess(np.mean(losses[-5:]), 0.5 * np.mean(losses[:3]), losses)
+        with torch.no_grad():
+            after_loss = float(guide_loss(raw.detach(), 64, 12345))
+        # Measured 0.07-0.12 of the start over five seed offsets.
+        self.assertLess(after_loss, 0.25 * before_loss, (before_loss, after_loss))
         moved = (raw.detach() - start).abs().numpy()
         own = np.zeros(moved.size, bool)
         for s in m.slices():
