@@ -8,9 +8,11 @@ metadata does not count) and every JSON / CSV with its timings and absolute path
 compares the hashes with the stored ones. `--update` stores the current hashes instead: run it only
 on the commit whose outputs define the reference, and say so in that commit.
 
-Floating-point results depend on the CPU's instruction set (Embree picks its kernels at run time), so
-the stored hashes hold for the machine that wrote them: the CI machine. The manifest records that
-machine's CPU model; on another CPU the test reports the mismatch as a skip (exit 77), not a failure.
+Floating-point results depend on the CPU's instruction set (Embree and libtorch pick their kernels at
+run time), so the stored hashes hold for the machine that wrote them: the CI machine. The manifest
+records that machine's CPU model and the vector extensions the kernels choose between; on another
+CPU the test reports the mismatch as a skip (exit 77), not a failure. The model string alone is not
+enough: two machines that both call themselves "AMD EPYC" wrote different plain renders.
 """
 import argparse
 import csv
@@ -39,6 +41,24 @@ def cpu_model():
     except OSError:
         pass
     return platform.processor() or "unknown"
+
+
+# The extensions Embree's and libtorch's run-time dispatch choose kernels by.
+DISPATCH_FLAGS = ("sse4_1", "sse4_2", "avx", "avx2", "fma", "f16c", "avx512f", "avx512dq", "avx512cd", "avx512bw",
+                  "avx512vl", "avx512_vnni", "avx512_bf16", "amx_tile")
+
+
+def cpu_isa():
+    """The DISPATCH_FLAGS this CPU has, space-separated ("unknown" where /proc/cpuinfo is absent)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("flags"):
+                    have = set(line.split(":", 1)[1].split())
+                    return " ".join(flag for flag in DISPATCH_FLAGS if flag in have)
+    except OSError:
+        pass
+    return "unknown"
 
 
 def commands(b, src, shared, out):
@@ -146,7 +166,7 @@ def main():
             current[name] = hash_outputs(folder)
 
     if args.update:
-        doc = {"cpu": cpu_model(), "runs": current}
+        doc = {"cpu": cpu_model(), "isa": cpu_isa(), "runs": current}
         tmp_path = MANIFEST + ".tmp"
         with open(tmp_path, "w") as f:
             json.dump(doc, f, indent=1, sort_keys=True)
@@ -172,8 +192,9 @@ def main():
         print(f"not run (no ../shared data?): {', '.join(missing)}")
     if differ:
         print(f"{len(differ)} of {checked} outputs differ from the stored ones:\n  " + "\n  ".join(differ))
-        if stored.get("cpu") != cpu_model():
-            print(f"stored on '{stored.get('cpu')}', this is '{cpu_model()}': skipped")
+        stored_on, this = (stored.get("cpu"), stored.get("isa")), (cpu_model(), cpu_isa())
+        if stored_on != this:
+            print(f"stored on '{stored_on[0]}' ({stored_on[1]}), this is '{this[0]}' ({this[1]}): skipped")
             return 77
         return 1
     print(f"{checked} outputs bit-identical to the stored ones ({len(current)} runs)")
