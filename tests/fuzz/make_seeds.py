@@ -153,7 +153,7 @@ def main():
             path = os.path.join(tmp, name)
             subprocess.run(["oiiotool", *args, "-o", path], check=True)
             put("image", name, pathlib.Path(path).read_bytes())
-    put("safetensors", "three_dtypes.safetensors", safetensors())
+    put("safetensors", "three_dtypes", safetensors())
     put("vae_json", "sd35.json", json.dumps({"channels": 16, "downsample": 8, "scale": 1.5305, "shift": 0.0609,
                                              "image_range": [-1, 1], "latent": "raw"}))
     put("edits", "demo.json", (SRC / "scenes/cornell-box/edits-demo.json").read_bytes())
