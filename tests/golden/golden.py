@@ -32,15 +32,20 @@ VOLATILE_KEYS = ("seconds", "seconds_per_iteration", "scene", "vae_dir", "lpips_
                  "reference", "vae_encoder", "vae_decoder", "vae_config", "out")
 
 
-def cpu_model():
+def cpuinfo_field(name):
+    """The first /proc/cpuinfo line's value for `name` ("model name", "flags"), or None."""
     try:
         with open("/proc/cpuinfo") as f:
             for line in f:
-                if line.startswith("model name"):
+                if line.startswith(name):
                     return line.split(":", 1)[1].strip()
     except OSError:
         pass
-    return platform.processor() or "unknown"
+    return None
+
+
+def cpu_model():
+    return cpuinfo_field("model name") or platform.processor() or "unknown"
 
 
 # The extensions Embree's and libtorch's run-time dispatch choose kernels by.
@@ -50,15 +55,11 @@ DISPATCH_FLAGS = ("sse4_1", "sse4_2", "avx", "avx2", "fma", "f16c", "avx512f", "
 
 def cpu_isa():
     """The DISPATCH_FLAGS this CPU has, space-separated ("unknown" where /proc/cpuinfo is absent)."""
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("flags"):
-                    have = set(line.split(":", 1)[1].split())
-                    return " ".join(flag for flag in DISPATCH_FLAGS if flag in have)
-    except OSError:
-        pass
-    return "unknown"
+    flags = cpuinfo_field("flags")
+    if flags is None:
+        return "unknown"
+    have = set(flags.split())
+    return " ".join(flag for flag in DISPATCH_FLAGS if flag in have)
 
 
 def commands(b, src, shared, out):
