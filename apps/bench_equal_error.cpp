@@ -76,7 +76,7 @@ void print_equal_error(const std::vector<Point>& lat, const std::vector<Point>& 
 }  // namespace
 
 int run_bench_equal_error(const BenchArgs& a) {
-    pipeline::FitFolder fit = pipeline::load_fit_folder(a.equal_error);
+    pipeline::FitFolder fit = pipeline::load_fit_folder(a.equal_error, {}, a.sampler);
     const fs::path dir(a.equal_error);
     const int w = fit.latent_width, h = fit.latent_height, W = 8 * w, H = 8 * h;
     if (!fs::exists(dir / "reference_rgb.exr"))

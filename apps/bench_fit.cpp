@@ -21,7 +21,7 @@ int run_bench_fit(const BenchArgs& a) {
         path = shared_dir() + "/scenes/cbox/cbox_specular.xml";
         if (!std::filesystem::exists(path)) path = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json";
     }
-    Scene scene = load_scene(path);
+    Scene scene = load_scene(path, {}, a.sampler);
     LatentModel model(scene, Parameterisation::Code, 1);
     std::vector<float> d_image(size_t(a.fit_res) * a.fit_res * kLatentChannels, 1e-3f);
     std::printf("scene %s, %dx%d latents x %d channels, max_depth %d, 2 passes per iteration\n", path.c_str(),

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,7 @@ struct RenderArgs {
     std::string aov_res;  ///< "WxH", empty = the image's
     float exposure = 0.f;
     std::map<std::string, std::string> defines;
+    std::optional<SamplerKind> sampler;  ///< --sampler: replaces the scene's (or the fit's)
     bool quiet = false;
     std::string edit;        ///< edits.json, when `scene` is a fit folder
     bool reference = false;  ///< also path trace + encode each edited frame, write metrics.csv
@@ -58,13 +60,14 @@ struct BenchArgs {
     std::string fit_scene;  ///< default: ../shared/scenes/cbox/cbox_specular.xml, else ours
     int fit_res = 128;
     std::vector<int> fit_spp{16, 64, 256};
-    std::string equal_error;   ///< fit folder: latent vs RGB time to equal error
-    int max_spp = 1024;        ///< --equal-error: highest RGB spp (latent: a quarter of it)
-    bool equal_noise = false;  ///< spp and seconds to a noise target, Sobol vs independent
-    std::string reference;     ///< --equal-noise: converged reference (default: Tungsten's, cornell box)
-    int target_spp = 64;       ///< --equal-noise: target = the independent sampler's noise at this spp
-    int seeds = 2;             ///< --equal-noise: renders per ladder point
-    bool startup = false;      ///< process start-up times of light and heavy commands
+    std::string equal_error;             ///< fit folder: latent vs RGB time to equal error
+    int max_spp = 1024;                  ///< --equal-error: highest RGB spp (latent: a quarter of it)
+    bool equal_noise = false;            ///< spp and seconds to a noise target, Sobol vs independent
+    std::string reference;               ///< --equal-noise: converged reference (default: Tungsten's, cornell box)
+    int target_spp = 64;                 ///< --equal-noise: target = the independent sampler's noise at this spp
+    int seeds = 2;                       ///< --equal-noise: renders per ladder point
+    bool startup = false;                ///< process start-up times of light and heavy commands
+    std::optional<SamplerKind> sampler;  ///< --sampler for --fit and --equal-error (the others run both)
 };
 int run_bench(const BenchArgs& args);
 int run_bench_fit(const BenchArgs& args);

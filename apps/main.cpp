@@ -415,6 +415,9 @@ struct Cli {
         compare->add_flag("--strict", cmp.strict, "exit with code 3 when the verdict is FAIL");
     }
 
+    /// --sampler for every subcommand that renders (none: each scene's own, or each fit's).
+    void set_sampler(std::optional<SamplerKind> s) { r.sampler = b.sampler = f.job.sampler = rf.job.sampler = s; }
+
     /// Runs the chosen subcommand (after parsing).
     int run() {
         if (*render) {
@@ -466,7 +469,7 @@ int main(int argc, char** argv) {
     app.add_option("--threads", cli.threads, "worker threads (default: all cores)")->check(lpt::app::positive());
     app.add_option("--sampler", cli.sampler,
                    "random numbers of every render: sobol (Owen-scrambled, low discrepancy) or independent "
-                   "(default: the scene's; docs/sampling.md)")
+                   "(default: the scene's; a fit keeps the one it was given; docs/sampling.md)")
         ->check(CLI::IsMember({"sobol", "independent"}));
     cli.add_render(app);
     cli.add_bench(app);
@@ -479,10 +482,8 @@ int main(int argc, char** argv) {
     std::unique_ptr<tbb::global_control> limit;
     if (cli.threads > 0)
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, cli.threads);
-    lpt::SamplerKind sampler_kind;
-    if (lpt::parse_sampler(cli.sampler, sampler_kind))
-        lpt::set_sampler_override(sampler_kind);  // empty: the scenes decide
     try {
+        cli.set_sampler(lpt::sampler_choice(cli.sampler, "--sampler"));  // empty: the scenes decide
         return cli.run();
     } catch (const std::exception& e) {
         std::cerr << "latentpt: error: " << e.what() << "\n";

@@ -18,7 +18,7 @@ std::string with_suffix(const std::string& exr_path, const std::string& suffix_e
 }  // namespace
 
 int run_render(const RenderArgs& a) {
-    Scene scene = load_scene(a.scene, a.defines);
+    Scene scene = load_scene(a.scene, a.defines, a.sampler);
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions opt = RenderOptions::from_scene(scene);
     opt.seed = a.seed;

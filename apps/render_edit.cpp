@@ -30,6 +30,7 @@ int run_render_edit(const RenderArgs& a) {
     job.edits = a.edit;
     job.out = a.out.empty() || a.out == "render.exr" ? "edit-out" : a.out;
     job.defines = a.defines;
+    job.sampler = a.sampler;
     if (!a.res.empty())
         parse_resolution(a.res, job.width, job.height, "--res");  // latent resolution may differ from training
     if (a.spp > 0) job.spp = a.spp;

@@ -4,6 +4,8 @@
 // low-discrepancy construction: docs/sampling.md.
 #pragma once
 #include <cstdint>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace lpt {
@@ -222,6 +224,15 @@ inline bool parse_sampler(const std::string& name, SamplerKind& out) {
     else if (name == "independent") out = SamplerKind::Independent;
     else return false;
     return true;
+}
+/// An optional choice that replaces a scene's: "" = none (the scene's own), else sampler_name's
+/// spelling; throws std::invalid_argument naming `option` for any other word.
+inline std::optional<SamplerKind> sampler_choice(const std::string& name, const std::string& option = "sampler") {
+    if (name.empty()) return std::nullopt;
+    SamplerKind k;
+    if (!parse_sampler(name, k))
+        throw std::invalid_argument(option + " must be 'sobol' or 'independent', got '" + name + "'");
+    return k;
 }
 
 /// The BSDF sample's random numbers at a depth: lobe choice and direction. Shared by the tracer

@@ -14,10 +14,6 @@
 
 namespace lpt {
 
-/// A process-wide sampler choice that overrides every scene's (the CLI's `--sampler`); tests and
-/// library users leave it unset and set RenderOptions::sampler instead.
-void set_sampler_override(SamplerKind kind);
-
 /// Which estimator collects light: both combined (MIS), or one alone (for tests/debugging).
 enum class LightStrategy { Mis, Nee, Bsdf };
 
@@ -31,8 +27,7 @@ struct RenderOptions {
     SamplerKind sampler = SamplerKind::Sobol;  ///< docs/sampling.md
     /// Called now and then with (fraction done, rays traced so far); from a worker thread.
     std::function<void(double, uint64_t)> progress;
-    /// The scene's settings; the sampler is the command line's `--sampler` where one was given
-    /// (set_sampler_override), else the scene's.
+    /// The scene's settings, its sampler included (load_scene's `sampler` replaces the file's).
     static RenderOptions from_scene(const Scene& scene);
     /// The same for an image of width × height (0: the camera's) at `spp` samples with `seed`.
     static RenderOptions from_scene(const Scene& scene, int width, int height, int spp, uint64_t seed);

@@ -155,6 +155,7 @@ std::string frame_key(const EditJob& job) {
     }
     add(read_file(job.edits));
     for (const auto& [key, value] : job.defines) add(key + "=" + value);
+    if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before
     add(std::to_string(job.width) + "x" + std::to_string(job.height) + " spp " + std::to_string(job.spp) + " seed " +
         std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp));
     char buf[40];
@@ -176,7 +177,7 @@ std::optional<std::string> finished_row(const fs::path& done, const std::string&
 int render_edits(const EditJob& job, const Reporter& report) {
     if (!fs::is_directory(job.fitdir))
         throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
-    EditSession session(job.fitdir, job.edits, job.defines);
+    EditSession session(job.fitdir, job.edits, job.defines, job.sampler);
     const int w = job.width > 0 ? job.width : session.latent_width();
     const int h = job.height > 0 ? job.height : session.latent_height();
     const Tools tools = open_tools(job, session, report);

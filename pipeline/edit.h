@@ -3,9 +3,11 @@
 // a refiner, decoded PNGs when its VAE is here, and with `reference` the RGB path trace of the
 // same edit encoded by the VAE and per-frame errors in metrics.csv (docs/metrics.md).
 #pragma once
+#include "core/sampler.h"
 #include "pipeline/progress.h"
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 namespace lpt::pipeline {
@@ -14,6 +16,7 @@ struct EditJob {
     std::string fitdir, edits;                   ///< fit folder, edits.json
     std::string out = "edit-out";                ///< output folder
     std::map<std::string, std::string> defines;  ///< override the fit's -D values
+    std::optional<SamplerKind> sampler;          ///< replaces the fit's (--sampler)
     int width = 0, height = 0;                   ///< latent resolution; 0 = the fit's
     int spp = 64;
     uint64_t seed = 0;  ///< frame i uses seed + i

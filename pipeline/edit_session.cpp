@@ -26,8 +26,10 @@ FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int widt
 }  // namespace
 
 EditSession::EditSession(const std::string& fitdir, const std::string& edits,
-                         const std::map<std::string, std::string>& defines)
-    : m_fit(load_fit_folder(fitdir, defines)), m_edits(load_edits(edits, *m_fit.scene)), m_camera(m_fit.scene->camera) {
+                         const std::map<std::string, std::string>& defines, std::optional<SamplerKind> sampler)
+    : m_fit(load_fit_folder(fitdir, defines, sampler)),
+      m_edits(load_edits(edits, *m_fit.scene)),
+      m_camera(m_fit.scene->camera) {
     const fs::path pt = fs::path(fitdir) / "refiner.pt";
     if (fs::exists(pt)) m_refiner = Refiner::load(pt.string());
     for (const Shape& s : m_fit.scene->shapes) m_original.push_back(s.mesh);

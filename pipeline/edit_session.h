@@ -8,6 +8,7 @@
 #include "refiner/refiner.h"
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,10 +23,11 @@ struct FrameLatents {
 
 class EditSession {
 public:
-    /// Loads the fit folder (defines override its -D values), its refiner when it has one, and
+    /// Loads the fit folder (defines override its -D values, sampler its sampler), its refiner when it has one, and
     /// the edit sequence; throws naming the file on bad input.
     EditSession(const std::string& fitdir, const std::string& edits,
-                const std::map<std::string, std::string>& defines = {});
+                const std::map<std::string, std::string>& defines = {},
+                std::optional<SamplerKind> sampler = std::nullopt);
     int frames() const { return m_edits.frames; }
     bool has_refiner() const { return m_refiner != nullptr; }
     int latent_width() const { return m_fit.latent_width; }

@@ -188,7 +188,7 @@ void validate(const FitJob& job) {
 
 FitSummary run_fit(const FitJob& job, const Reporter& report) {
     validate(job);
-    const Scene scene = load_scene(job.scene, job.defines);
+    const Scene scene = load_scene(job.scene, job.defines, job.sampler);
     LatentModel model(scene, parameterisation_from_string(job.param), job.options.seed);
     configure_terms(model, job.gate, job.terms);
     FitOptions o = job.options;
@@ -220,6 +220,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     if (job.refiner) {
         RefineJob r = job.refine;
         r.fitdir = job.out;
+        r.sampler = job.sampler;
         r.train.seed = job.options.seed;
         r.resume = resume;  // a stage 1 started again makes the old refiner checkpoint stale too
         r.restart_if_changed = job.restart_if_changed;

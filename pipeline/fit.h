@@ -16,6 +16,7 @@ namespace lpt::pipeline {
 struct FitJob {
     std::string scene;                           ///< .json or Mitsuba 3 .xml
     std::map<std::string, std::string> defines;  ///< -D overrides
+    std::optional<SamplerKind> sampler;          ///< replaces the scene file's (--sampler); kept in fit.json
     std::string out = "fit-out";                 ///< the fit folder
 
     // The target: `target` if given, else the encoded RGB reference with `encode`, else synthetic.

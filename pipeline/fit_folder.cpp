@@ -34,7 +34,8 @@ void configure_terms(LatentModel& model, const std::string& gate, const std::str
     t.occlusion = terms.find('c') != std::string::npos;
 }
 
-FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::string, std::string>& overrides) {
+FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::string, std::string>& overrides,
+                          std::optional<SamplerKind> sampler) {
     const fs::path dir(dir_name);
     if (!fs::is_directory(dir))
         throw std::runtime_error(dir_name + ": not a folder (expected a fit folder made by latentpt fit)");
@@ -53,7 +54,9 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
         if (!fs::exists(scene, ec))
             throw std::runtime_error(manifest_path + ": field 'scene': " + scene +
                                      " does not exist (moved since the fit? fit.json names it by path)");
-        f.scene = std::make_unique<Scene>(load_scene(scene, defines));
+        if (!sampler && m.contains("sampler"))
+            sampler = sampler_choice(m.at("sampler").get<std::string>(), manifest_path + ": field 'sampler'");
+        f.scene = std::make_unique<Scene>(load_scene(scene, defines, sampler));
         f.model = std::make_unique<LatentModel>(*f.scene, parameterisation_from_string(m.value("param", "code")), 0);
         const std::string params_path = (dir / "params.json").string();
         if (!fs::exists(params_path)) throw std::runtime_error(params_path + ": missing");
@@ -86,6 +89,7 @@ nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, 
                         {"seed", o.seed},
                         {"vae_dir", default_vae_dir(job.vae.dir)},
                         {"ref_tone", job.ref_tone}};
+    if (job.sampler) m["sampler"] = sampler_name(*job.sampler);  // absent: the scene file's
     if (job.vae.torchscript())
         m["vae_torchscript"] = {{"encoder", fs::absolute(job.vae.encoder).string()},
                                 {"decoder", fs::absolute(job.vae.decoder).string()},

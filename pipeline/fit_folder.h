@@ -4,11 +4,13 @@
 #pragma once
 #include "autodiff/tone_curve.h"
 #include "core/image_io.h"
+#include "core/sampler.h"
 #include "core/scene.h"
 #include "latent/latent_model.h"
 #include "pipeline/vae_source.h"
 #include <map>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -33,8 +35,10 @@ struct FitFolder {
 };
 
 /// Throws std::runtime_error naming the file for a missing or malformed fit.json / params.json.
-/// `defines` override the fit's own -D values.
-FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, std::string>& defines = {});
+/// `defines` override the fit's own -D values, `sampler` the one the fit was made with (fit.json's
+/// "sampler" when the fit was given one, else the scene file's).
+FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, std::string>& defines = {},
+                          std::optional<SamplerKind> sampler = std::nullopt);
 
 /// The fitted model's tone-mapped latent of its (possibly edited) scene at w × h, spp and seed:
 /// what edited frames and the refiner's extra training renders are made of.

@@ -253,7 +253,7 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     RefineSummary s;
     // The fitted scene (a load of the scene and its BVH) only when extra views need it.
     const bool needs_fit = job.noise_views > 1 || job.augment != RefinerAugment::None;
-    const FitFolder fit = needs_fit ? load_fit_folder(job.fitdir) : FitFolder{};
+    const FitFolder fit = needs_fit ? load_fit_folder(job.fitdir, {}, job.sampler) : FitFolder{};
     const std::vector<RefinerExample> examples =
         training_examples(job, fit, noise_views(job, fit, in, report), target, judges, report);
     if (examples.size() > 1 && o.patience > 0)

@@ -2,10 +2,12 @@
 // (latent.exr, aov.exr) against target.exr (and reference_rgb.exr for LPIPS when present) and
 // writes refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json and decoded_refined.png.
 #pragma once
+#include "core/sampler.h"
 #include "pipeline/progress.h"
 #include "pipeline/refiner_augment.h"
 #include "refiner/refiner.h"
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 namespace lpt::pipeline {
@@ -24,7 +26,8 @@ struct RefineJob {
     /// Apply the trained refiner on windows the size of its training crop (RefinerConfig::tile)
     /// when InstanceNorm is on and the crop is smaller than the view; false: the whole view at once.
     bool windowed_inference = true;
-    bool resume = false;  ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
+    std::optional<SamplerKind> sampler;  ///< replaces the fit's for the extra views (--sampler)
+    bool resume = false;                 ///< continue from <fitdir>/refiner_checkpoint.pt when it exists
     /// With resume: a checkpoint trained with other settings (refiner_checkpoint.json) is removed
     /// and training starts again, instead of an error (pipeline/fit_checkpoint.h).
     bool restart_if_changed = false;

@@ -41,8 +41,9 @@ std::shared_ptr<LatentScene> fresh(std::shared_ptr<Scene> scene, const std::stri
     return ls;
 }
 
-std::shared_ptr<LatentScene> from_fit(const std::string& dir, const std::map<std::string, std::string>& defines) {
-    pipeline::FitFolder f = pipeline::load_fit_folder(dir, defines);
+std::shared_ptr<LatentScene> from_fit(const std::string& dir, const std::map<std::string, std::string>& defines,
+                                      const std::string& sampler) {
+    pipeline::FitFolder f = pipeline::load_fit_folder(dir, defines, sampler_choice(sampler));
     auto ls = std::make_shared<LatentScene>();
     ls->scene = std::shared_ptr<Scene>(std::move(f.scene));
     ls->model = std::move(f.model);
@@ -147,7 +148,9 @@ void bind_latent(py::module_& m) {
              py::arg("terms") = "eac", py::arg("gate") = "shadowed", py::arg("tone") = "clip", py::arg("width") = 0,
              py::arg("height") = 0, "A fresh model of `scene`, parameters initialised from `seed` (docs/params.md).")
         .def_static("from_fit", &from_fit, py::arg("fitdir"), py::arg("defines") = std::map<std::string, std::string>{},
-                    "The fitted model of a fit folder written by `latentpt fit` or latentpt.fit().")
+                    py::arg("sampler") = "",
+                    "The fitted model of a fit folder written by `latentpt fit` or latentpt.fit(); `sampler` "
+                    "replaces the fit's.")
         .def_property_readonly("width", [](const LatentScene& l) { return l.width; })
         .def_property_readonly("height", [](const LatentScene& l) { return l.height; })
         .def_property_readonly("scene", [](const LatentScene& l) { return l.scene; })

@@ -81,6 +81,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "augment") job.augment = pipeline::parse_refiner_augment(value.cast<std::string>());
     else if (k == "checkpoint_every") t.checkpoint_every = value.cast<int>();
     else if (k == "lpips_dir") job.lpips_dir = value.cast<std::string>();
+    else if (k == "sampler" && prefix.empty()) job.sampler = sampler_choice(value.cast<std::string>(), shown);
     else if (k == "seed") t.seed = value.cast<uint64_t>();
     else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
     else return false;
@@ -116,6 +117,7 @@ void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
         else if (k == "resume") job.resume = value.cast<bool>();
         else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
         else if (k == "refiner") job.refiner = value.cast<bool>();
+        else if (k == "sampler") job.sampler = sampler_choice(value.cast<std::string>(), k);
         else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
         else if (k == "lpips_dir") job.refine.lpips_dir = value.cast<std::string>();  // fit --lpips-dir
         else if (k.rfind("refiner_", 0) == 0 && k != "refiner_seed" &&
@@ -160,8 +162,9 @@ py::dict run_refine(const std::string& fitdir, bool resume, const py::object& pr
 }
 
 int render_edits(const std::string& fitdir, const std::string& edits, const std::string& out, int spp, uint64_t seed,
-                 bool reference, const py::object& progress, const py::object& note) {
+                 bool reference, const std::string& sampler, const py::object& progress, const py::object& note) {
     pipeline::EditJob job;
+    job.sampler = sampler_choice(sampler);
     job.fitdir = fitdir;
     job.edits = edits;
     job.out = out;
@@ -226,9 +229,10 @@ void bind_pipeline(py::module_& m) {
           "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
           "(iterations, lr, lr_decay, crop, patience, augment, noise_views, norm, inference, dropout, seed, ...).");
     m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
-          py::arg("seed") = 0, py::arg("reference") = false, py::arg("progress") = py::none(),
+          py::arg("seed") = 0, py::arg("reference") = false, py::arg("sampler") = "", py::arg("progress") = py::none(),
           py::arg("note") = py::none(),
-          "A fit's edit sequence (edits.json, as `render --edit`); returns the number of frames.");
+          "A fit's edit sequence (edits.json, as `render --edit`); returns the number of frames. `sampler` "
+          "replaces the fit's.");
     py::class_<PyVae>(m, "Vae", "An image autoencoder: TAESD3 weights in a folder (default ../shared/models/taesd3).")
         .def(py::init([](const std::string& dir) {
                  return PyVae{std::shared_ptr<Vae>(pipeline::open_vae({dir, "", "", ""}))};
@@ -244,8 +248,12 @@ void bind_pipeline(py::module_& m) {
         .def("decode", &decode, py::arg("latent"), "Latent (h, w, 16) -> display RGB (8h, 8w, 3).");
     py::class_<pipeline::EditSession>(m, "EditSession",
                                       "A fit's edit sequence (the JSON of render --edit), frame by frame as arrays.")
-        .def(py::init<const std::string&, const std::string&, const std::map<std::string, std::string>&>(),
-             py::arg("fitdir"), py::arg("edits"), py::arg("defines") = std::map<std::string, std::string>{})
+        .def(py::init([](const std::string& fitdir, const std::string& edits,
+                         const std::map<std::string, std::string>& defines, const std::string& sampler) {
+                 return std::make_unique<pipeline::EditSession>(fitdir, edits, defines, sampler_choice(sampler));
+             }),
+             py::arg("fitdir"), py::arg("edits"), py::arg("defines") = std::map<std::string, std::string>{},
+             py::arg("sampler") = "")
         .def_property_readonly("frames", &pipeline::EditSession::frames)
         .def_property_readonly("has_refiner", &pipeline::EditSession::has_refiner)
         .def("frame", &edited_frame, py::arg("i"), py::arg("spp") = 64, py::arg("seed") = 0, py::arg("width") = 0,

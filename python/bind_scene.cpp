@@ -49,11 +49,20 @@ py::dict render_aov_images(const Scene& scene, int width, int height, int spp, u
 void bind_scene(py::module_& m) {
     py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene",
                                               "A scene file (.json or Mitsuba 3 .xml) loaded for rendering.")
-        .def(py::init([](const std::string& path, const std::map<std::string, std::string>& defines) {
-                 return std::make_shared<Scene>(load_scene(path, defines));
+        .def(py::init([](const std::string& path, const std::map<std::string, std::string>& defines,
+                         const std::string& sampler) {
+                 return std::make_shared<Scene>(load_scene(path, defines, sampler_choice(sampler)));
              }),
-             py::arg("path"), py::arg("defines") = std::map<std::string, std::string>{},
-             "Loads a scene; `defines` override values as -D does on the command line.")
+             py::arg("path"), py::arg("defines") = std::map<std::string, std::string>{}, py::arg("sampler") = "",
+             "Loads a scene; `defines` override values as -D does on the command line, `sampler` ('sobol' or "
+             "'independent') the file's as --sampler does.")
+        .def_property(
+            "sampler", [](const Scene& s) { return std::string(sampler_name(s.integrator.sampler)); },
+            [](Scene& s, const std::string& name) {
+                if (!parse_sampler(name, s.integrator.sampler))
+                    throw py::value_error("sampler must be 'sobol' or 'independent', got '" + name + "'");
+            },
+            "'sobol' or 'independent': the random numbers of every render of this scene (docs/sampling.md).")
         .def_property_readonly("width", [](const Scene& s) { return s.camera.width; })
         .def_property_readonly("height", [](const Scene& s) { return s.camera.height; })
         .def_property_readonly("spp", [](const Scene& s) { return s.integrator.spp; })

@@ -387,12 +387,21 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
     return scene;
 }
 
-Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines) {
+namespace {
+Scene load_scene_by_extension(const std::string& path, const std::map<std::string, std::string>& defines) {
     std::string ext = fs::path(path).extension().string();
     for (auto& ch : ext) ch = char(std::tolower(ch));
     if (ext == ".json") return load_scene_json(path, defines);
     if (ext == ".xml") return load_scene_mitsuba_xml(path, defines);
     throw SceneError(path, "", "unknown scene format '" + ext + "' (known: .json, .xml)");
+}
+}  // namespace
+
+Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines,
+                 std::optional<SamplerKind> sampler) {
+    Scene scene = load_scene_by_extension(path, defines);
+    if (sampler) scene.integrator.sampler = *sampler;
+    return scene;
 }
 
 }  // namespace lpt

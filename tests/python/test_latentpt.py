@@ -224,6 +224,49 @@ class PipelineTest(unittest.TestCase):
                 latentpt.fit(BOX, cancelled, no_such_option=1)
 
 
+class SamplerTest(unittest.TestCase):
+    """`sampler=` (the CLI's --sampler) belongs to the scene or fit it is given to, not to the process:
+    each call must render exactly what the scene file's own `integrator.sampler` renders."""
+
+    INDEPENDENT = {"integrator.sampler": "independent"}  # the file's own choice, as a -D value
+
+    def test_a_scene_renders_with_its_own_sampler(self):
+        args = dict(spp=4, width=16, height=16, seed=3)
+        sobol, chosen = latentpt.Scene(BOX), latentpt.Scene(BOX, sampler="independent")
+        self.assertEqual((sobol.sampler, chosen.sampler), ("sobol", "independent"))
+        by_file = latentpt.Scene(BOX, defines=self.INDEPENDENT).render(**args)
+        np.testing.assert_array_equal(chosen.render(**args), by_file)
+        self.assertFalse(np.array_equal(sobol.render(**args), by_file))  # the other scene kept its own
+        sobol.sampler = "independent"
+        np.testing.assert_array_equal(sobol.render(**args), by_file)
+        with self.assertRaises(ValueError):
+            latentpt.Scene(BOX, sampler="halton")
+        with self.assertRaises(ValueError):
+            sobol.sampler = "halton"
+
+    def test_a_fit_keeps_its_sampler_for_what_renders_it_later(self):
+        small = dict(note=lambda t: None, synthetic_res="8x8", iterations=4, spp=2, final_spp=4, refiner=False)
+        depth = {"integrator.max_depth": "3"}
+        with tempfile.TemporaryDirectory() as d:
+            chosen, by_file, sobol = (os.path.join(d, n) for n in ("chosen", "by_file", "sobol"))
+            latentpt.fit(BOX, chosen, defines=depth, sampler="independent", **small)
+            latentpt.fit(BOX, by_file, defines={**depth, **self.INDEPENDENT}, **small)
+            latentpt.fit(BOX, sobol, defines=depth, **small)
+            def params(fit):
+                with open(os.path.join(fit, "params.json")) as f:
+                    return f.read()
+            self.assertEqual(params(chosen), params(by_file))
+            self.assertNotEqual(params(chosen), params(sobol))
+            with open(os.path.join(chosen, "fit.json")) as f:
+                self.assertEqual(json.load(f)["sampler"], "independent")
+            self.assertEqual(latentpt.LatentScene.from_fit(chosen).scene.sampler, "independent")
+            self.assertEqual(latentpt.LatentScene.from_fit(chosen, sampler="sobol").scene.sampler, "sobol")
+            edits = os.path.join(SRC, "scenes", "cornell-box", "edits-demo.json")
+            frame = lambda **kw: latentpt.EditSession(sobol, edits, **kw).frame(3, spp=2)["latent"]  # noqa: E731
+            np.testing.assert_array_equal(frame(sampler="independent"), frame(defines=self.INDEPENDENT))
+            self.assertFalse(np.array_equal(frame(), frame(defines=self.INDEPENDENT)))
+
+
 class OneProcessTest(unittest.TestCase):
     def test_refine_takes_the_command_lines_options(self):
         """refine(**options) trains as `latentpt refine --options` does: the same refiner.pt, byte for
