@@ -40,6 +40,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import experiment_lib as X  # noqa: E402
@@ -116,13 +117,20 @@ def main():
         sys.exit(f"experiment: {c['out']} is in use by another experiment run")
     config_path = os.path.join(c["out"], "experiment-config.json")
     X.write_atomic(config_path, json.dumps(c, indent=1))
+    started = time.time()
     r = subprocess.run(snakemake_command(a, config_path, c["out"]))
     if r.returncode != 0:
         sys.exit(f"experiment: the workflow failed (exit {r.returncode}); job logs in {c['out']}/<scene>/logs; "
                  "run again with the same flags to continue")
     if "--dry-run" in a.snakemake_args or "-n" in a.snakemake_args:
         return 0
-    with open(os.path.join(c["out"], "summary.md")) as f:
+    summary = os.path.join(c["out"], "summary.md")
+    if not os.path.exists(summary):  # targets named after -- that leave the summary out
+        print(f"experiment: the named targets are done; no {summary} yet (the whole workflow writes it)")
+        return 0
+    if os.path.getmtime(summary) < started:
+        print(f"experiment: {summary} is from an earlier run (up to date, or left out by the targets named after --)")
+    with open(summary) as f:
         print(f.read())
     with open(os.path.join(c["out"], "summary.json")) as f:
         failures = json.load(f)["failures"]
