@@ -33,16 +33,16 @@ class Preset(unittest.TestCase):
         self.assertEqual(X.fits_of(c), ["e", "ea", "eac"])
         self.assertNotIn("baseline", [k for k, _ in X.configs_of(c)])
         self.assertIn("--ref-spp 512", X.fit_command(c, "cbox-specular", "e", 2))
-        # every fit of the preset decays the emission; a resumed fit restarts if its settings changed
+        # every fit of the preset decays the emitters' responses; a resumed fit restarts if its settings changed
         for fit in ("e", "ea", "eac"):
-            self.assertIn("--emission-decay 0.0001", X.fit_command(c, "cbox-specular", fit, 2))
+            self.assertIn("--emitter-response-decay 0.0001", X.fit_command(c, "cbox-specular", fit, 2))
             self.assertIn("--resume --restart-if-changed", X.fit_command(c, "cbox-specular", fit, 2))
-        self.assertNotIn("--emission-decay", X.fit_command(X.settings(), "cbox-specular", "ea", 2))
-        self.assertNotIn("--emitter-response-decay", X.fit_command(c, "cbox-specular", "ea", 2))
-        # the decays as flags: an explicit value overrides the preset's, 0 drops the option
-        c = X.settings(paper=True, emission_decay=0, emitter_response_decay=1e-4)
+        self.assertNotIn("--emitter-response-decay", X.fit_command(X.settings(), "cbox-specular", "ea", 2))
         self.assertNotIn("--emission-decay", X.fit_command(c, "cbox-specular", "ea", 2))
-        self.assertIn("--emitter-response-decay 0.0001", X.fit_command(c, "cbox-specular", "ea", 2))
+        # the decays as flags: an explicit value overrides the preset's, 0 drops the option
+        c = X.settings(paper=True, emission_decay=1e-4, emitter_response_decay=0)
+        self.assertIn("--emission-decay 0.0001", X.fit_command(c, "cbox-specular", "ea", 2))
+        self.assertNotIn("--emitter-response-decay", X.fit_command(c, "cbox-specular", "ea", 2))
         c = X.settings(paper=True, image_res=256, frame_step=2, fit_iterations=10)
         self.assertEqual(X.image_res_of(c, "cbox-specular"), 256)
         self.assertEqual((c["frame_step"], c["fit_iterations"]), (2, 10))
