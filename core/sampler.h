@@ -225,14 +225,17 @@ inline bool parse_sampler(const std::string& name, SamplerKind& out) {
     else return false;
     return true;
 }
-/// An optional choice that replaces a scene's: "" = none (the scene's own), else sampler_name's
-/// spelling; throws std::invalid_argument naming `option` for any other word.
-inline std::optional<SamplerKind> sampler_choice(const std::string& name, const std::string& option = "sampler") {
-    if (name.empty()) return std::nullopt;
+/// parse_sampler for a caller's value: throws std::invalid_argument naming `option` for any other word.
+inline SamplerKind sampler_named(const std::string& name, const std::string& option = "sampler") {
     SamplerKind k;
     if (!parse_sampler(name, k))
         throw std::invalid_argument(option + " must be 'sobol' or 'independent', got '" + name + "'");
     return k;
+}
+/// An optional choice that replaces a scene's: "" = none (the scene's own), else sampler_named's.
+inline std::optional<SamplerKind> sampler_choice(const std::string& name, const std::string& option = "sampler") {
+    if (name.empty()) return std::nullopt;
+    return sampler_named(name, option);
 }
 
 /// The BSDF sample's random numbers at a depth: lobe choice and direction. Shared by the tracer

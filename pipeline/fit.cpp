@@ -220,7 +220,6 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     if (job.refiner) {
         RefineJob r = job.refine;
         r.fitdir = job.out;
-        r.sampler = job.sampler;
         r.train.seed = job.options.seed;
         r.resume = resume;  // a stage 1 started again makes the old refiner checkpoint stale too
         r.restart_if_changed = job.restart_if_changed;

@@ -58,10 +58,7 @@ void bind_scene(py::module_& m) {
              "'independent') the file's as --sampler does.")
         .def_property(
             "sampler", [](const Scene& s) { return std::string(sampler_name(s.integrator.sampler)); },
-            [](Scene& s, const std::string& name) {
-                if (!parse_sampler(name, s.integrator.sampler))
-                    throw py::value_error("sampler must be 'sobol' or 'independent', got '" + name + "'");
-            },
+            [](Scene& s, const std::string& name) { s.integrator.sampler = sampler_named(name); },
             "'sobol' or 'independent': the random numbers of every render of this scene (docs/sampling.md).")
         .def_property_readonly("width", [](const Scene& s) { return s.camera.width; })
         .def_property_readonly("height", [](const Scene& s) { return s.camera.height; })
