@@ -89,6 +89,13 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
         ->check(CLI::IsMember({"instance", "none"}))
         ->default_str(ra.net.instance_norm ? "instance" : "none");
     sc->add_option_function<std::string>(
+          "--" + pre + "arch",
+          [&ra, pre](const std::string& v) { ra.net.arch = parse_refiner_arch(v, "--" + pre + "arch"); },
+          "network body: conv (three convolutions at full resolution, the paper's blocks) or unet (a two-level "
+          "U-Net with skip connections, a wider view at a fifth of the cost per pixel)")
+        ->check(CLI::IsMember({"conv", "unet"}))
+        ->default_str(to_string(ra.net.arch));
+    sc->add_option_function<std::string>(
           "--" + pre + "inference", [&ra](const std::string& v) { ra.windowed_inference = v == "windows"; },
           "how the trained refiner is applied: windows (the training crop's size, stride half of it, averaged; "
           "InstanceNorm then sees what it saw in training) or whole (the whole view at once)")

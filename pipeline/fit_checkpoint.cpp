@@ -120,6 +120,7 @@ nlohmann::json stage2_settings(const RefineJob& job) {
                         {"noise_views", job.noise_views},
                         {"augment", to_string(job.augment)}};
     if (t.cosine_decay) s["iterations"] = t.iterations;
+    if (job.net.arch != RefinerArch::Conv) s["arch"] = to_string(job.net.arch);  // older checkpoints resume
     return s;
 }
 

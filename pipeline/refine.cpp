@@ -84,19 +84,22 @@ std::string refiner_csv(const RefinerTrainResult& res) {
 
 nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, const RefinerTrainResult& res) {
     const double seconds = res.history.empty() ? 0.0 : res.history.back().seconds;
-    return {{"expansion", job.net.expansion},
-            {"norm", refiner.config().instance_norm ? "instance" : "none"},
-            {"parameters", refiner.parameter_count()},
-            {"iterations", res.history.size()},
-            {"best_iteration", res.best_iteration},
-            {"seconds", seconds},
-            {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
-            {"crop", job.train.crop},
-            {"noise_views", job.noise_views},
-            {"augment", to_string(job.augment)},
-            {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
-            {"inference_window", refiner.config().tile},
-            {"lpips_crop", job.train.lpips_crop}};
+    nlohmann::json record = {
+        {"expansion", job.net.expansion},
+        {"norm", refiner.config().instance_norm ? "instance" : "none"},
+        {"parameters", refiner.parameter_count()},
+        {"iterations", res.history.size()},
+        {"best_iteration", res.best_iteration},
+        {"seconds", seconds},
+        {"seconds_per_iteration", res.history.empty() ? 0.0 : seconds / double(res.history.size())},
+        {"crop", job.train.crop},
+        {"noise_views", job.noise_views},
+        {"augment", to_string(job.augment)},
+        {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
+        {"inference_window", refiner.config().tile},
+        {"lpips_crop", job.train.lpips_crop}};
+    if (refiner.config().arch != RefinerArch::Conv) record["arch"] = to_string(refiner.config().arch);
+    return record;
 }
 
 /// metrics.json: latent MSE of the rendered and refined latents against the target, and with a

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,11 @@ namespace lpt {
 
 class Vae;
 class Lpips;
+
+/// The refiner's body. conv: three convolutions at full resolution (3×3, 5×5, 3×3; the paper's
+/// blocks, a 9×9 receptive field). unet: a two-level U-Net with skip connections (widths W/4,
+/// W/2, W; a ~44-pixel receptive field), docs/refiner.md "U-Net".
+enum class RefinerArch { Conv, UNet };
 
 struct RefinerConfig {
     int latent_channels = 16;
@@ -31,7 +37,18 @@ struct RefinerConfig {
     /// (docs/refiner.md "Windows"). A view no larger than the window is one window: the whole view.
     /// Files written before the option hold none and load as 0.
     int tile = 0;
+    /// Files written before the option hold none and load as conv.
+    RefinerArch arch = RefinerArch::Conv;
 };
+
+inline const char* to_string(RefinerArch arch) { return arch == RefinerArch::UNet ? "unet" : "conv"; }
+/// "conv" or "unet"; throws std::invalid_argument naming `option` otherwise. Inline: the
+/// torch-free readers of the options (pipeline, apps) parse it without linking the network.
+inline RefinerArch parse_refiner_arch(const std::string& name, const std::string& option) {
+    if (name == "conv") return RefinerArch::Conv;
+    if (name == "unet") return RefinerArch::UNet;
+    throw std::invalid_argument(option + ": '" + name + "' is not a refiner architecture (conv or unet)");
+}
 
 /// What the refiner reads for one view: the rendered (tone-mapped) latent and its AOVs.
 struct RefinerInput {

@@ -62,6 +62,11 @@ RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
         throw std::invalid_argument(
             "refiner: invalid configuration (channels, expansion >= 1; squash, distance scale > 0; dropout in [0, 1))");
     const int64_t c = config.latent_channels, width = int64_t(config.expansion) * c;
+    if (config.arch == RefinerArch::UNet) {
+        unet = register_module("unet", UNetBody(c + kRefinerAovChannels, width, config.instance_norm, config.dropout));
+        head = register_module("head", conv(unet->out_channels(), c, 1));
+        return;
+    }
     c1 = register_module("c1", conv(c + kRefinerAovChannels, width, 3));
     c2 = register_module("c2", conv(width, width, 5));
     c3 = register_module("c3", conv(width, width, 3));
@@ -80,6 +85,7 @@ RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
 torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x) {
     auto norm = [](torch::nn::InstanceNorm2d& n, const torch::Tensor& t) { return n.is_empty() ? t : n(t); };
     torch::Tensor h = torch::tanh(x / cfg.squash);
+    if (!unet.is_empty()) return x.narrow(1, 0, cfg.latent_channels) + head(unet(h));
     h = drop(torch::relu(norm(n1, c1(h))));
     h = drop(torch::relu(norm(n2, c2(h))));
     h = drop(torch::relu(norm(n3, c3(h))));
@@ -89,6 +95,12 @@ torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x) {
 bool archived_instance_norm(torch::serialize::InputArchive& ar) {
     c10::IValue norm;
     return !ar.try_read("config.instance_norm", norm) || norm.toInt() != 0;
+}
+
+RefinerArch archived_arch(torch::serialize::InputArchive& ar) {
+    c10::IValue arch;
+    return ar.try_read("config.arch", arch) && arch.toInt() == int64_t(RefinerArch::UNet) ? RefinerArch::UNet
+                                                                                          : RefinerArch::Conv;
 }
 
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config) {
@@ -151,6 +163,7 @@ void Refiner::save(const std::string& path) const {
     ar.write("config.distance_scale", c10::IValue(double(c.distance_scale)));
     ar.write("config.instance_norm", c10::IValue(int64_t(c.instance_norm)));
     ar.write("config.tile", c10::IValue(int64_t(c.tile)));
+    if (c.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(c.arch)));  // conv files as before
     const std::string tmp = path + ".tmp";
     ar.save_to(tmp);
     std::filesystem::rename(tmp, path);
@@ -177,6 +190,7 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c.instance_norm = archived_instance_norm(ar);
         c10::IValue tile;
         c.tile = ar.try_read("config.tile", tile) ? int(tile.toInt()) : 0;  // older files: the whole view
+        c.arch = archived_arch(ar);
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
         impl->net->load(ar);
         return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));

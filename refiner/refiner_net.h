@@ -2,22 +2,24 @@
 // refiner_train.cpp. Internal to refiner/: include only from .cpp files there.
 #pragma once
 #include "refiner/refiner.h"
+#include "refiner/refiner_unet_torch.h"
 #include <torch/torch.h>
 
 namespace lpt {
 
-/// tanh(x / squash) → [conv k, InstanceNorm (unless config.instance_norm is false), ReLU, Dropout]
-/// for k = 3, 5, 3 → 1×1 conv, and the result is added to the unsquashed latent (the first
-/// latent_channels input channels).
+/// tanh(x / squash) → body → 1×1 conv, and the result is added to the unsquashed latent (the
+/// first latent_channels input channels). The conv body: [conv k, InstanceNorm (unless
+/// config.instance_norm is false), ReLU, Dropout] for k = 3, 5, 3; the unet body: UNetBody.
 struct RefinerNetImpl : torch::nn::Module {
     explicit RefinerNetImpl(const RefinerConfig& config);
     /// x: [N, latent_channels + 4, h, w] (latent, normal xyz, scaled distance) → refined latent.
     torch::Tensor forward(const torch::Tensor& x);
 
     RefinerConfig cfg;
-    torch::nn::Conv2d c1{nullptr}, c2{nullptr}, c3{nullptr}, head{nullptr};
-    torch::nn::InstanceNorm2d n1{nullptr}, n2{nullptr}, n3{nullptr};  ///< empty without instance_norm
+    torch::nn::Conv2d c1{nullptr}, c2{nullptr}, c3{nullptr}, head{nullptr};  ///< c1–c3: conv body only
+    torch::nn::InstanceNorm2d n1{nullptr}, n2{nullptr}, n3{nullptr};         ///< empty without instance_norm
     torch::nn::Dropout drop{nullptr};
+    UNetBody unet{nullptr};  ///< unet body only
 };
 TORCH_MODULE(RefinerNet);
 
@@ -31,6 +33,8 @@ constexpr int kRefinerAovChannels = 4;  ///< normal (3) + distance (1)
 /// The instance_norm flag stored in a refiner.pt or checkpoint archive; files written before the
 /// option have none and all had InstanceNorm.
 bool archived_instance_norm(torch::serialize::InputArchive& ar);
+/// The body stored in a refiner.pt or checkpoint archive; files written before the option are conv.
+RefinerArch archived_arch(torch::serialize::InputArchive& ar);
 
 /// The network input [1, C + 4, h, w] of a view (distance divided by config.distance_scale).
 /// Throws std::invalid_argument on buffer sizes that do not match width × height.

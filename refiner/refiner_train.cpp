@@ -63,6 +63,10 @@ void check_checkpoint_network(const std::string& path, torch::serialize::InputAr
     if (norm != cfg.instance_norm)
         throw std::runtime_error(path + ": the checkpoint was trained with --norm " + (norm ? "instance" : "none") +
                                  "; resume with the same --norm, or start again without --resume");
+    const RefinerArch arch = archived_arch(ar);
+    if (arch != cfg.arch)
+        throw std::runtime_error(path + ": the checkpoint was trained with --arch " + to_string(arch) +
+                                 "; resume with the same --arch, or start again without --resume");
     c10::IValue v;
     if (ar.try_read("config.expansion", v) && v.toInt() != cfg.expansion)
         throw std::runtime_error(path + ": the checkpoint was trained with --expansion " + std::to_string(v.toInt()) +
@@ -116,6 +120,7 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
     torch::serialize::OutputArchive ar, net_ar, best_ar, adam_ar;
     ar.write("config.instance_norm", c10::IValue(int64_t(cfg.instance_norm)));
     ar.write("config.expansion", c10::IValue(int64_t(cfg.expansion)));
+    if (cfg.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(cfg.arch)));
     net->save(net_ar);
     ar.write("net", net_ar);
     RefinerNet tmp(cfg);

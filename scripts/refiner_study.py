@@ -118,6 +118,15 @@ VARIANTS = {
     # kept: it stopped at 4199 where mse_6000_cosine_dihedral, the same options, stopped at 4251).
     "mse_6000_cosine_dihedral_per_view": ("mse_6000_cosine_dihedral with early stopping on the mean of per-view EMAs",
                                           MSE + ["--lr-decay", "cosine", "--augment", "dihedral"], False, 6000),
+    # Another body (session 19): a two-level U-Net, a ~44-pixel view at a fifth of the multiply-adds.
+    "mse_6000_cosine_unet": ("mse_6000_cosine with the U-Net body (--arch unet: widths 64, 128, 256, skip "
+                             "connections)", MSE + ["--lr-decay", "cosine", "--arch", "unet"], False, 6000),
+    # Patience 500 stopped mse_6000_cosine_unet at 3928 steps (its crop loss falls more slowly).
+    "mse_6000_cosine_unet_all": ("mse_6000_cosine_unet without early stopping (the whole cosine period)",
+                                 MSE + ["--lr-decay", "cosine", "--arch", "unet", "--patience", "0"], False, 6000),
+    "mse_6000_cosine_unet_x32_all": ("mse_6000_cosine_unet_all twice as wide (expansion 32: widths 128, 256, 512)",
+                                     MSE + ["--lr-decay", "cosine", "--arch", "unet", "--patience", "0",
+                                            "--expansion", "32"], False, 6000),
     "mse_9000_cosine": ("latent MSE alone for 9000 iterations, lr falling along a half cosine to 0",
                         MSE + ["--lr-decay", "cosine"], False, 9000),
     "long": ("ours for 3000 iterations (the paper's count)", [], False, 3000),
