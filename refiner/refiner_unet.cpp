@@ -13,8 +13,9 @@ torch::nn::Conv2d conv3(int64_t in, int64_t out) {
 }
 
 torch::Tensor upsample2(const torch::Tensor& x) {
-    return torch::nn::functional::interpolate(
-        x, torch::nn::functional::InterpolateFuncOptions().scale_factor(std::vector<double>{2.0, 2.0}).mode(torch::kNearest));
+    return torch::nn::functional::interpolate(x, torch::nn::functional::InterpolateFuncOptions()
+                                                     .scale_factor(std::vector<double>{2.0, 2.0})
+                                                     .mode(torch::kNearest));
 }
 
 }  // namespace
@@ -53,8 +54,7 @@ torch::Tensor UNetBodyImpl::forward(const torch::Tensor& x) {
     const int64_t h = x.size(2), w = x.size(3);
     const int64_t ph = (kScale - h % kScale) % kScale, pw = (kScale - w % kScale) % kScale;
     // Replication, not zeros: the padded rows continue the view instead of adding an edge.
-    const torch::Tensor xp =
-        ph || pw ? F::pad(x, F::PadFuncOptions({0, pw, 0, ph}).mode(torch::kReplicate)) : x;
+    const torch::Tensor xp = ph || pw ? F::pad(x, F::PadFuncOptions({0, pw, 0, ph}).mode(torch::kReplicate)) : x;
     const torch::Tensor s1 = enc1(xp);
     const torch::Tensor s2 = enc2(F::avg_pool2d(s1, F::AvgPool2dFuncOptions(2)));
     const torch::Tensor m = mid(F::avg_pool2d(s2, F::AvgPool2dFuncOptions(2)));

@@ -80,4 +80,3 @@ TEST(Refiner, UNetStartsAsIdentityTrainsAndSeesFurther) {
     }
     EXPECT_THROW(parse_refiner_arch("mlp", "--refiner-arch"), std::invalid_argument);
 }
-
