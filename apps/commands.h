@@ -4,6 +4,7 @@
 #include "pipeline/fit.h"
 #include "pipeline/paths.h"
 #include "pipeline/progress.h"
+#include "pipeline/reference.h"
 #include "pipeline/refine.h"
 #include "pipeline/resolution.h"
 #include "pipeline/vae_source.h"
@@ -43,6 +44,7 @@ struct RenderArgs {
     std::string edit;        ///< edits.json, when `scene` is a fit folder
     bool reference = false;  ///< also path trace + encode each edited frame, write metrics.csv
     int ref_spp = 256;
+    uint64_t ref_seed = pipeline::kReferenceSeed;
     std::string reference_cache;  ///< folder keeping path-traced reference frames for reuse
     std::string frames;           ///< with edit: "A:B", only frames A..B (inclusive)
     bool resume = false;          ///< with edit: skip frames an earlier run finished

@@ -151,6 +151,11 @@ struct Cli {
         render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")
             ->capture_default_str()
             ->check(positive());
+        render
+            ->add_option("--ref-seed", r.ref_seed,
+                         "with --reference: the references' seed; another one traces independent references of the "
+                         "same frames (cached under their own names), e.g. to measure their noise")
+            ->capture_default_str();
         render->add_option("--reference-cache", r.reference_cache,
                            "with --reference: keep path-traced frames in this folder and reuse them "
                            "(keyed by edits file name, size, spp, tone and frame)");

@@ -37,6 +37,7 @@ int run_render_edit(const RenderArgs& a) {
     job.seed = a.seed;
     job.reference = a.reference;
     job.ref_spp = a.ref_spp;
+    job.ref_seed = a.ref_seed;
     job.reference_cache = a.reference_cache;
     job.resume = a.resume;
     if (!a.frames.empty()) parse_frames(a.frames, job.first_frame, job.last_frame, job.frame_step);

@@ -100,12 +100,13 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
     std::string cached;
     if (!job.reference_cache.empty())
         cached = (fs::path(job.reference_cache) /
-                  (unedited ? training_reference_key(8 * w, 8 * h, job.ref_spp, fit.ref_tone)
-                            : fs::path(job.edits).stem().string() + "_" + std::to_string(8 * w) + "x" +
-                                  std::to_string(8 * h) + "_" + std::to_string(job.ref_spp) + "spp_" + fit.ref_tone +
-                                  "_" + frame))
+                  ((unedited ? training_reference_key(8 * w, 8 * h, job.ref_spp, fit.ref_tone)
+                             : fs::path(job.edits).stem().string() + "_" + std::to_string(8 * w) + "x" +
+                                   std::to_string(8 * h) + "_" + std::to_string(job.ref_spp) + "spp_" + fit.ref_tone +
+                                   "_" + frame) +
+                   reference_seed_suffix(job.ref_seed)))
                      .string();
-    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, fit.ref_tone, *t.vae, cached,
+    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, job.ref_seed, fit.ref_tone, *t.vae, cached,
                                     stem + "_reference.png", ref_rgb);
 }
 
@@ -157,7 +158,8 @@ std::string frame_key(const EditJob& job) {
     for (const auto& [key, value] : job.defines) add(key + "=" + value);
     if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before
     add(std::to_string(job.width) + "x" + std::to_string(job.height) + " spp " + std::to_string(job.spp) + " seed " +
-        std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp));
+        std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp) +
+        reference_seed_suffix(job.ref_seed));  // empty for the default seed: keys as before
     char buf[40];
     std::snprintf(buf, sizeof buf, "key %016llx", static_cast<unsigned long long>(h));
     return buf;

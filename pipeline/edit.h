@@ -5,6 +5,7 @@
 #pragma once
 #include "core/sampler.h"
 #include "pipeline/progress.h"
+#include "pipeline/reference.h"
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -22,6 +23,9 @@ struct EditJob {
     uint64_t seed = 0;  ///< frame i uses seed + i
     bool reference = false;
     int ref_spp = 256;
+    /// The references' seed: another one path traces
+    /// independent references of the same frames, to measure their noise (docs/metrics.md).
+    uint64_t ref_seed = kReferenceSeed;
     std::string reference_cache;  ///< keeps path-traced reference frames for reuse
     /// Only frames first_frame..last_frame (inclusive; -1 = the last): a sequence split into jobs
     /// gives the same frame files as one job, since frame i depends on i alone (seed + i). A

@@ -17,15 +17,15 @@ float display_value(float v, const std::string& tone) {
     return std::pow(v, 1.f / 2.2f);
 }
 
-std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone,
-                                        const Vae& vae, const std::string& save_png, std::vector<float>* display_rgb,
-                                        const Reporter& report) {
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                        const std::string& tone, const Vae& vae, const std::string& save_png,
+                                        std::vector<float>* display_rgb, const Reporter& report) {
     const int f = vae.convention().downsample;
     if (width % f || height % f)
         throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) +
                                     " in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
-    RenderOptions o = RenderOptions::from_scene(scene, width, height, spp, 0x5eed);
+    RenderOptions o = RenderOptions::from_scene(scene, width, height, spp, seed);
     RenderStats st;
     std::vector<float> rgb = render_path<3>(scene, spectra, o, &st).develop();
     for (float& v : rgb) v = display_value(v, tone);
@@ -42,12 +42,17 @@ std::string training_reference_key(int width, int height, int spp, const std::st
            tone;
 }
 
-std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, const std::string& tone,
-                                            const Vae& vae, const std::string& cache_stem, const std::string& save_png,
-                                            std::vector<float>& display_rgb, const Reporter& report) {
+std::string reference_seed_suffix(uint64_t seed) {
+    return seed == kReferenceSeed ? std::string() : "_seed" + std::to_string(seed);
+}
+
+std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                            const std::string& tone, const Vae& vae, const std::string& cache_stem,
+                                            const std::string& save_png, std::vector<float>& display_rgb,
+                                            const Reporter& report) {
     namespace fs = std::filesystem;
     if (cache_stem.empty())
-        return encoded_reference_of(scene, width, height, spp, tone, vae, save_png, &display_rgb, report);
+        return encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
     const std::string rgb_file = cache_stem + ".exr", latent_file = cache_stem + "_latent.exr";
     const int f = vae.convention().downsample, channels = vae.convention().channels;
     const auto write_latent_file = [&](const std::vector<float>& latent) {
@@ -55,7 +60,7 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
     };
     if (!fs::exists(rgb_file)) {
         std::vector<float> latent =
-            encoded_reference_of(scene, width, height, spp, tone, vae, save_png, &display_rgb, report);
+            encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
         fs::create_directories(fs::path(cache_stem).parent_path());
         write_latent_file(latent);
         write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}});

@@ -1,6 +1,7 @@
 // The paper's target: the scene path traced in RGB, display-mapped, encoded by the VAE.
 #pragma once
 #include "pipeline/progress.h"
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -15,16 +16,24 @@ namespace lpt::pipeline {
 /// then x^(1/2.2).
 float display_value(float v, const std::string& tone);
 
-/// Path-traced RGB of `scene` at width x height and `spp` (seed 0x5eed), display-mapped with
+/// The seed of every reference unless told otherwise: fits, edit sequences and the bench share it.
+constexpr uint64_t kReferenceSeed = 0x5eed;
+
+/// Path-traced RGB of `scene` at width x height and `spp` with `seed`, display-mapped with
 /// `tone`, encoded by `vae`. `save_png` (if not empty) receives the display image, `display_rgb`
 /// (if given) its values. Throws if the size is not a multiple of the VAE's downsampling.
-std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, const std::string& tone,
-                                        const Vae& vae, const std::string& save_png,
+/// Another seed gives an independent reference of the same view (same sampler): two of them
+/// measure a reference's own noise (docs/metrics.md "Reference noise").
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                        const std::string& tone, const Vae& vae, const std::string& save_png,
                                         std::vector<float>* display_rgb = nullptr, const Reporter& report = {});
 
 /// The cache name of a view's training reference ("training_<W>x<H>_<spp>spp_<tone>"): fits
 /// and the unedited frames of edit sequences share it.
 std::string training_reference_key(int width, int height, int spp, const std::string& tone);
+/// What a cache key gains for a reference of another seed ("_seed<N>"; nothing for
+/// kReferenceSeed, so caches written before the option keep their names).
+std::string reference_seed_suffix(uint64_t seed);
 
 /// encoded_reference_of through a cache: `cache_stem`.exr holds the display RGB and
 /// `cache_stem`_latent.exr its encoding. A cached reference is read (and re-encoded only when its
@@ -32,8 +41,9 @@ std::string training_reference_key(int width, int height, int spp, const std::st
 /// atomically, so several jobs (an experiment's fits and edit sequences) trace a reference once
 /// and encode it once. An empty `cache_stem` caches nothing. `display_rgb` receives the display
 /// image and `save_png` (if not empty) a picture of it.
-std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, const std::string& tone,
-                                            const Vae& vae, const std::string& cache_stem, const std::string& save_png,
-                                            std::vector<float>& display_rgb, const Reporter& report = {});
+std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                            const std::string& tone, const Vae& vae, const std::string& cache_stem,
+                                            const std::string& save_png, std::vector<float>& display_rgb,
+                                            const Reporter& report = {});
 
 }  // namespace lpt::pipeline

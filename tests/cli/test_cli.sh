@@ -153,6 +153,15 @@ if [ -d "$shared/models/taesd3" ]; then
     # From the cache: the same references, so the same metrics.
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2c"
     check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
+    # Another --ref-seed: independent references of the same frames under their own cache names
+    # (the edited frame's and the training view's), the default seed's files untouched.
+    cp -r "$out/refs" "$out/refs_before"
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --ref-seed 7 --out "$out/ed2r"
+    check test "$(ls "$out/refs" | grep -c _seed7)" -eq 4
+    check test -s "$out/refs/training_16x16_2spp_clip_seed7.exr"
+    for f in "$out/refs_before"/*; do check cmp "$f" "$out/refs/$(basename "$f")"; done
+    check sh -c "! cmp -s '$out/refs/move_16x16_2spp_clip_frame_0001.exr' '$out/refs/move_16x16_2spp_clip_frame_0001_seed7.exr'"
+    check sh -c "! cmp -s '$out/ed2/metrics.csv' '$out/ed2r/metrics.csv'"
     # The workflow's chunk jobs (frames 0:0 and 1:1, each writing metrics_A-B.csv) merged by
     # experiment_lib.merge_metrics: byte for byte the one job's metrics.csv (issue 20).
     for r in 0:0 1:1; do
