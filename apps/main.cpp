@@ -45,44 +45,32 @@ void add_vae_options(CLI::App* sc, VaeSource& vs) {
         ->check(CLI::ExistingFile);
 }
 
+/// A number option that shows its default and checks its range.
+template <class T>
+void add_number(CLI::App* sc, const std::string& name, T& value, const std::string& help, const CLI::Validator& check) {
+    sc->add_option(name, value, help)->capture_default_str()->check(check);
+}
+
 /// Stage-2 options: `--refiner-<name>` on fit, `--<name>` on refine.
 void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string& pre) {
-    sc->add_option("--" + pre + "iterations", ra.train.iterations, "refiner training steps")
-        ->capture_default_str()
-        ->check(positive());
-    sc->add_option("--" + pre + "expansion", ra.net.expansion, "refiner width = expansion x 16 channels")
-        ->capture_default_str()
-        ->check(positive());
-    sc->add_option("--" + pre + "crop", ra.train.crop, "latent crop side per refiner step (0 = the whole view)")
-        ->capture_default_str()
-        ->check(non_negative());
-    sc->add_option("--" + pre + "lpips-crop", ra.train.lpips_crop,
-                   "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)")
-        ->capture_default_str()
-        ->check(non_negative());
-    sc->add_option("--" + pre + "lr", ra.train.lr, "refiner Adam learning rate")
-        ->capture_default_str()
-        ->check(positive());
+    add_number(sc, "--" + pre + "iterations", ra.train.iterations, "refiner training steps", positive());
+    add_number(sc, "--" + pre + "expansion", ra.net.expansion, "refiner width = expansion x 16 channels", positive());
+    add_number(sc, "--" + pre + "crop", ra.train.crop, "latent crop side per refiner step (0 = the whole view)",
+               non_negative());
+    add_number(sc, "--" + pre + "lpips-crop", ra.train.lpips_crop,
+               "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)", non_negative());
+    add_number(sc, "--" + pre + "lr", ra.train.lr, "refiner Adam learning rate", positive());
     sc->add_option_function<std::string>(
           "--" + pre + "lr-decay", [&ra](const std::string& v) { ra.train.cosine_decay = v == "cosine"; },
           "refiner learning rate over the steps: none (constant) or cosine (one half cosine down to 0)")
         ->check(CLI::IsMember({"none", "cosine"}))
         ->default_str(ra.train.cosine_decay ? "cosine" : "none");
-    sc->add_option("--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off")
-        ->capture_default_str()
-        ->check(non_negative());
-    sc->add_option("--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE")
-        ->capture_default_str()
-        ->check(non_negative());
-    sc->add_option("--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM")
-        ->capture_default_str()
-        ->check(non_negative());
-    sc->add_option("--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops")
-        ->capture_default_str()
-        ->check(non_negative());
-    sc->add_option("--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)")
-        ->capture_default_str()
-        ->check(positive());
+    add_number(sc, "--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off",
+               non_negative());
+    add_number(sc, "--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE", non_negative());
+    add_number(sc, "--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM", non_negative());
+    add_number(sc, "--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops", non_negative());
+    add_number(sc, "--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)", positive());
     sc->add_option_function<std::string>(
           "--" + pre + "norm", [&ra](const std::string& v) { ra.net.instance_norm = v == "instance"; },
           "normalisation after each convolution: instance (ours) or none (the paper's network)")
@@ -96,14 +84,18 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
         ->check(CLI::IsMember({"conv", "unet"}))
         ->default_str(to_string(ra.net.arch));
     sc->add_option_function<std::string>(
+          "--" + pre + "inputs", [&ra](const std::string& v) { ra.net.terms = v == "terms"; },
+          "what the refiner reads besides the AOVs: latent (the toned render) or terms (also its transport terms "
+          "Ie, Ia, Ic before the tone curve; edits then render them too)")
+        ->check(CLI::IsMember({"latent", "terms"}))
+        ->default_str(ra.net.terms ? "terms" : "latent");
+    sc->add_option_function<std::string>(
           "--" + pre + "inference", [&ra](const std::string& v) { ra.windowed_inference = v == "windows"; },
           "how the trained refiner is applied: windows (the training crop's size, stride half of it, averaged; "
           "InstanceNorm then sees what it saw in training) or whole (the whole view at once)")
         ->check(CLI::IsMember({"windows", "whole"}))
         ->default_str(ra.windowed_inference ? "windows" : "whole");
-    sc->add_option("--" + pre + "dropout", ra.net.dropout, "dropout after each block")
-        ->capture_default_str()
-        ->check(CLI::Range(0.0, 0.99));
+    add_number(sc, "--" + pre + "dropout", ra.net.dropout, "dropout after each block", CLI::Range(0.0, 0.99));
     sc->add_option("--" + pre + "noise-views", ra.noise_views,
                    "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone")
         ->capture_default_str()
@@ -114,9 +106,8 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
           "(also the camera rolled by quarter turns); each against its reference moved the same way and encoded")
         ->check(CLI::IsMember({"none", "mirror", "dihedral"}))
         ->default_str(pipeline::to_string(ra.augment));
-    sc->add_option("--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints")
-        ->capture_default_str()
-        ->check(non_negative());
+    add_number(sc, "--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints",
+               non_negative());
     sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
 }
 

@@ -14,12 +14,14 @@ FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int widt
     FrameLatents f;
     f.width = width;
     f.height = height;
-    f.latent = render_fit_latent(fit, width, height, spp, seed);
-    if (refiner) {
-        // Same spp and seed as the latent: an identity edit reproduces the fit's refined latent.
-        f.view = refiner_view(*fit.scene, f.latent, width, height, spp, seed);
-        f.refined = refiner->refine(f.view);
+    if (!refiner) {
+        f.latent = render_fit_latent(fit, width, height, spp, seed);
+        return f;
     }
+    // Same spp and seed as the fit's latent: an identity edit reproduces its refined latent.
+    f.view = fit_refiner_view(fit, refiner->config(), width, height, spp, seed);
+    f.latent = f.view.latent;
+    f.refined = refiner->refine(f.view);
     return f;
 }
 

@@ -121,6 +121,7 @@ nlohmann::json stage2_settings(const RefineJob& job) {
                         {"augment", to_string(job.augment)}};
     if (t.cosine_decay) s["iterations"] = t.iterations;
     if (job.net.arch != RefinerArch::Conv) s["arch"] = to_string(job.net.arch);  // older checkpoints resume
+    if (job.net.terms) s["inputs"] = "terms";
     return s;
 }
 

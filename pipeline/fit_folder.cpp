@@ -2,6 +2,7 @@
 #include "autodiff/fit.h"
 #include "core/json_number.h"
 #include "core/scene_loader.h"
+#include "integrators/path.h"
 #include "pipeline/fit.h"
 #include "pipeline/paths.h"
 #include <filesystem>
@@ -24,6 +25,27 @@ nlohmann::json parse_json_file(const std::string& path) {
 
 std::vector<float> render_fit_latent(const FitFolder& fit, int w, int h, int spp, uint64_t seed) {
     return render_toned(*fit.model, RenderOptions::from_scene(*fit.scene, w, h, spp, seed), fit.tone);
+}
+
+FitRender render_fit_terms(const FitFolder& fit, int w, int h, int spp, uint64_t seed) {
+    const LatentModel& model = *fit.model;
+    const TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(
+        model.scene(), model.spectra(), model.terms(), RenderOptions::from_scene(*fit.scene, w, h, spp, seed));
+    FitRender r;
+    r.toned = films.sum();  // as render_toned: the sum, then the tone curve in place
+    tone_map(fit.tone, r.toned.data(), r.toned.data(), r.toned.size());
+    r.terms = interleave_terms(films.e.develop(), films.a.develop(), films.c.develop(), kLatentChannels);
+    return r;
+}
+
+std::vector<float> interleave_terms(const std::vector<float>& e, const std::vector<float>& a,
+                                    const std::vector<float>& c, int channels) {
+    std::vector<float> out;
+    out.reserve(e.size() * 3);
+    for (size_t p = 0; p < e.size(); p += size_t(channels))
+        for (const std::vector<float>* term : {&e, &a, &c})
+            out.insert(out.end(), term->begin() + std::ptrdiff_t(p), term->begin() + std::ptrdiff_t(p) + channels);
+    return out;
 }
 
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {

@@ -44,6 +44,17 @@ FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, st
 /// what edited frames and the refiner's extra training renders are made of.
 std::vector<float> render_fit_latent(const FitFolder& fit, int w, int h, int spp, uint64_t seed);
 
+/// The same render with its transport terms: `toned` is render_fit_latent's latent, `terms` the
+/// Ĩe, Ĩa, Ĩc it sums, interleaved per pixel (RefinerInput::terms), linear.
+struct FitRender {
+    std::vector<float> toned, terms;
+};
+FitRender render_fit_terms(const FitFolder& fit, int w, int h, int spp, uint64_t seed);
+
+/// Ĩe, Ĩa, Ĩc images (`channels` per pixel each) interleaved per pixel as RefinerInput::terms.
+std::vector<float> interleave_terms(const std::vector<float>& e, const std::vector<float>& a,
+                                    const std::vector<float>& c, int channels);
+
 /// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac").
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
 

@@ -99,6 +99,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
         {"inference_window", refiner.config().tile},
         {"lpips_crop", job.train.lpips_crop}};
     if (refiner.config().arch != RefinerArch::Conv) record["arch"] = to_string(refiner.config().arch);
+    if (refiner.config().terms) record["inputs"] = "terms";
     return record;
 }
 
@@ -141,7 +142,7 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit
     const int w = views[0].width, h = views[0].height;
     for (int k = 1; k < job.noise_views; ++k) {
         const uint64_t seed = noise_view_seed(fit_seed, k);
-        views.push_back(refiner_view(*fit.scene, render_fit_latent(fit, w, h, spp, seed), w, h, spp, seed));
+        views.push_back(fit_refiner_view(fit, job.net, w, h, spp, seed));
     }
     return views;
 }
@@ -224,6 +225,7 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         throw std::runtime_error(job.fitdir + ": not a folder (expected a fit folder made by latentpt fit)");
     const OutputLock lock(job.fitdir);
     RefinerInput in = load_refiner_input((dir / "latent.exr").string(), (dir / "aov.exr").string());
+    if (job.net.terms) in.terms = load_refiner_terms(job.fitdir, in.width, in.height);
     const Image target = read_fit_image((dir / "target.exr").string(), kLatentChannels, in.width, in.height);
     const Judges judges = open_judges(job, target, report);
 

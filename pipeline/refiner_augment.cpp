@@ -75,6 +75,7 @@ RefinerInput transform_view(const RefinerInput& in, ViewTransform t, const Vec3f
     out.latent = transform_image(in.latent, in.width, in.height, c, t);
     out.normal = transform_image(in.normal, in.width, in.height, 3, t);
     out.distance = transform_image(in.distance, in.width, in.height, 1, t);
+    if (!in.terms.empty()) out.terms = transform_image(in.terms, in.width, in.height, 3 * c, t);
     if (t.mirror)
         for (size_t i = 0; i + 2 < out.normal.size(); i += 3) {
             const Vec3f n(out.normal[i], out.normal[i + 1], out.normal[i + 2]);

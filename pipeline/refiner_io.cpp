@@ -4,6 +4,7 @@
 #include "latent/latent.h"
 #include "pipeline/fit_folder.h"
 #include <algorithm>
+#include <filesystem>
 #include <stdexcept>
 
 namespace lpt::pipeline {
@@ -17,6 +18,22 @@ RefinerInput refiner_view(const Scene& scene, std::vector<float> latent, int w, 
     in.normal = std::move(aov.normal);
     in.distance = std::move(aov.distance);
     return in;
+}
+
+RefinerInput fit_refiner_view(const FitFolder& fit, const RefinerConfig& config, int w, int h, int spp, uint64_t seed) {
+    if (!config.terms) return refiner_view(*fit.scene, render_fit_latent(fit, w, h, spp, seed), w, h, spp, seed);
+    FitRender r = render_fit_terms(fit, w, h, spp, seed);
+    RefinerInput in = refiner_view(*fit.scene, std::move(r.toned), w, h, spp, seed);
+    in.terms = std::move(r.terms);
+    return in;
+}
+
+std::vector<float> load_refiner_terms(const std::string& fitdir, int w, int h) {
+    std::vector<float> term[3];
+    const char* files[3] = {"latent_e.exr", "latent_a.exr", "latent_c.exr"};
+    for (int k = 0; k < 3; ++k)
+        term[k] = read_fit_image((std::filesystem::path(fitdir) / files[k]).string(), kLatentChannels, w, h).data;
+    return interleave_terms(term[0], term[1], term[2], kLatentChannels);
 }
 
 void write_refiner_aovs(const std::string& path, const RefinerInput& in) {

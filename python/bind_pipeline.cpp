@@ -75,6 +75,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "w_lpips") t.w_lpips = value.cast<float>();
     else if (k == "squash") n.squash = value.cast<float>();
     else if (k == "arch") n.arch = parse_refiner_arch(value.cast<std::string>(), shown);
+    else if (k == "inputs") n.terms = either(shown, value.cast<std::string>(), "terms", "latent");
     else if (k == "norm") n.instance_norm = either(shown, value.cast<std::string>(), "instance", "none");
     else if (k == "inference") job.windowed_inference = either(shown, value.cast<std::string>(), "windows", "whole");
     else if (k == "dropout") n.dropout = value.cast<float>();
@@ -225,11 +226,11 @@ void bind_pipeline(py::module_& m) {
         py::arg("progress") = py::none(), py::arg("note") = py::none(),
         "Stage 1 (and stage 2 unless refiner=False) into the fit folder `out`; keyword options as the CLI's "
         "(iterations, spp, seed, lr, encode, encode_res, synthetic_res, param, gate, terms, refiner_iterations, ...).");
-    m.def(
-        "refine", &run_refine, py::arg("fitdir"), py::arg("resume") = false, py::arg("progress") = py::none(),
-        py::arg("note") = py::none(),
-        "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
-        "(iterations, lr, lr_decay, crop, patience, augment, noise_views, norm, arch, inference, dropout, seed, ...).");
+    m.def("refine", &run_refine, py::arg("fitdir"), py::arg("resume") = false, py::arg("progress") = py::none(),
+          py::arg("note") = py::none(),
+          "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
+          "(iterations, lr, lr_decay, crop, patience, augment, noise_views, norm, arch, inputs, inference, dropout, "
+          "seed, ...).");
     m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("sampler") = "", py::arg("progress") = py::none(),
           py::arg("note") = py::none(),

@@ -39,6 +39,11 @@ struct RefinerConfig {
     int tile = 0;
     /// Files written before the option hold none and load as conv.
     RefinerArch arch = RefinerArch::Conv;
+    /// Also read the three transport terms Ĩe, Ĩa, Ĩc of the same render (linear, before the tone
+    /// curve; RefinerInput::terms) beside their toned sum: where light was occluded or came from
+    /// the flat response, which the sum mixes (docs/refiner.md "Transport terms"). Files written
+    /// before the option hold none and load as false.
+    bool terms = false;
 };
 
 inline const char* to_string(RefinerArch arch) { return arch == RefinerArch::UNet ? "unet" : "conv"; }
@@ -56,6 +61,9 @@ struct RefinerInput {
     std::vector<float> latent;    ///< width × height × latent_channels
     std::vector<float> normal;    ///< width × height × 3
     std::vector<float> distance;  ///< width × height × 1 (0 where the camera ray escapes)
+    /// width × height × 3·latent_channels: Ĩe, Ĩa, Ĩc of each pixel in turn (linear); read only by
+    /// refiners with RefinerConfig::terms, empty otherwise.
+    std::vector<float> terms;
 };
 
 /// One training pair: a render of a view and what it should refine to.

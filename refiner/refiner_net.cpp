@@ -63,11 +63,12 @@ RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
             "refiner: invalid configuration (channels, expansion >= 1; squash, distance scale > 0; dropout in [0, 1))");
     const int64_t c = config.latent_channels, width = int64_t(config.expansion) * c;
     if (config.arch == RefinerArch::UNet) {
-        unet = register_module("unet", UNetBody(c + kRefinerAovChannels, width, config.instance_norm, config.dropout));
+        unet = register_module("unet",
+                               UNetBody(refiner_input_channels(config), width, config.instance_norm, config.dropout));
         head = register_module("head", conv(unet->out_channels(), c, 1));
         return;
     }
-    c1 = register_module("c1", conv(c + kRefinerAovChannels, width, 3));
+    c1 = register_module("c1", conv(refiner_input_channels(config), width, 3));
     c2 = register_module("c2", conv(width, width, 5));
     c3 = register_module("c3", conv(width, width, 3));
     head = register_module("head", conv(width, c, 1));
@@ -103,17 +104,33 @@ RefinerArch archived_arch(torch::serialize::InputArchive& ar) {
                                                                                           : RefinerArch::Conv;
 }
 
+bool archived_terms(torch::serialize::InputArchive& ar) {
+    c10::IValue terms;
+    return ar.try_read("config.terms", terms) && terms.toInt() != 0;
+}
+
+int64_t refiner_input_channels(const RefinerConfig& config) {
+    return int64_t(config.latent_channels) * (config.terms ? 4 : 1) + kRefinerAovChannels;
+}
+
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config) {
     const int64_t w = in.width, h = in.height, c = config.latent_channels, n = w * h;
     if (w < 1 || h < 1) throw std::invalid_argument("refiner: empty view");
     if (int64_t(in.latent.size()) != n * c || int64_t(in.normal.size()) != n * 3 || int64_t(in.distance.size()) != n)
         throw std::invalid_argument("refiner: a " + std::to_string(w) + "x" + std::to_string(h) + " view needs " +
                                     std::to_string(c) + " latent, 3 normal and 1 distance channels per pixel");
+    if (config.terms && int64_t(in.terms.size()) != n * 3 * c)
+        throw std::invalid_argument("refiner: this refiner reads the transport terms: a " + std::to_string(w) + "x" +
+                                    std::to_string(h) + " view needs " + std::to_string(3 * c) +
+                                    " term channels per pixel (Ĩe, Ĩa, Ĩc), got " + std::to_string(in.terms.size()) +
+                                    " values");
     auto nchw = [&](const std::vector<float>& v, int64_t ch) {
         return torch::from_blob(const_cast<float*>(v.data()), {1, h, w, ch}).permute({0, 3, 1, 2});
     };
-    return torch::cat({nchw(in.latent, c), nchw(in.normal, 3), nchw(in.distance, 1) / config.distance_scale}, 1)
-        .contiguous();
+    std::vector<torch::Tensor> parts = {nchw(in.latent, c), nchw(in.normal, 3),
+                                        nchw(in.distance, 1) / config.distance_scale};
+    if (config.terms) parts.push_back(nchw(in.terms, 3 * c));
+    return torch::cat(parts, 1).contiguous();
 }
 
 std::vector<float> refiner_to_hwc(const torch::Tensor& nchw) {
@@ -164,6 +181,7 @@ void Refiner::save(const std::string& path) const {
     ar.write("config.instance_norm", c10::IValue(int64_t(c.instance_norm)));
     ar.write("config.tile", c10::IValue(int64_t(c.tile)));
     if (c.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(c.arch)));  // conv files as before
+    if (c.terms) ar.write("config.terms", c10::IValue(int64_t(1)));  // files without terms as before
     const std::string tmp = path + ".tmp";
     ar.save_to(tmp);
     std::filesystem::rename(tmp, path);
@@ -191,6 +209,7 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c10::IValue tile;
         c.tile = ar.try_read("config.tile", tile) ? int(tile.toInt()) : 0;  // older files: the whole view
         c.arch = archived_arch(ar);
+        c.terms = archived_terms(ar);
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
         impl->net->load(ar);
         return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));

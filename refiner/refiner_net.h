@@ -12,7 +12,8 @@ namespace lpt {
 /// config.instance_norm is false), ReLU, Dropout] for k = 3, 5, 3; the unet body: UNetBody.
 struct RefinerNetImpl : torch::nn::Module {
     explicit RefinerNetImpl(const RefinerConfig& config);
-    /// x: [N, latent_channels + 4, h, w] (latent, normal xyz, scaled distance) → refined latent.
+    /// x: [N, refiner_input_channels, h, w] (latent, normal xyz, scaled distance[, Ĩe, Ĩa, Ĩc]) →
+    /// refined latent.
     torch::Tensor forward(const torch::Tensor& x);
 
     RefinerConfig cfg;
@@ -29,14 +30,19 @@ struct Refiner::Impl {
 };
 
 constexpr int kRefinerAovChannels = 4;  ///< normal (3) + distance (1)
+/// Input channels of a network with `config`: latent, AOVs, and with config.terms Ĩe, Ĩa, Ĩc.
+int64_t refiner_input_channels(const RefinerConfig& config);
 
 /// The instance_norm flag stored in a refiner.pt or checkpoint archive; files written before the
 /// option have none and all had InstanceNorm.
 bool archived_instance_norm(torch::serialize::InputArchive& ar);
 /// The body stored in a refiner.pt or checkpoint archive; files written before the option are conv.
 RefinerArch archived_arch(torch::serialize::InputArchive& ar);
+/// The terms flag stored in an archive; files written before the option read no terms.
+bool archived_terms(torch::serialize::InputArchive& ar);
 
-/// The network input [1, C + 4, h, w] of a view (distance divided by config.distance_scale).
+/// The network input [1, refiner_input_channels, h, w] of a view (distance divided by
+/// config.distance_scale; the terms appended when config.terms).
 /// Throws std::invalid_argument on buffer sizes that do not match width × height.
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config);
 /// [1, C, h, w] → interleaved h × w × C floats.

@@ -67,6 +67,10 @@ void check_checkpoint_network(const std::string& path, torch::serialize::InputAr
     if (arch != cfg.arch)
         throw std::runtime_error(path + ": the checkpoint was trained with --arch " + to_string(arch) +
                                  "; resume with the same --arch, or start again without --resume");
+    const bool terms = archived_terms(ar);
+    if (terms != cfg.terms)
+        throw std::runtime_error(path + ": the checkpoint was trained with --inputs " + (terms ? "terms" : "latent") +
+                                 "; resume with the same --inputs, or start again without --resume");
     c10::IValue v;
     if (ar.try_read("config.expansion", v) && v.toInt() != cfg.expansion)
         throw std::runtime_error(path + ": the checkpoint was trained with --expansion " + std::to_string(v.toInt()) +
@@ -121,6 +125,7 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
     ar.write("config.instance_norm", c10::IValue(int64_t(cfg.instance_norm)));
     ar.write("config.expansion", c10::IValue(int64_t(cfg.expansion)));
     if (cfg.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(cfg.arch)));
+    if (cfg.terms) ar.write("config.terms", c10::IValue(int64_t(1)));
     net->save(net_ar);
     ar.write("net", net_ar);
     RefinerNet tmp(cfg);

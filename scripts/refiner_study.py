@@ -104,6 +104,9 @@ VARIANTS = {
                                     MSE + ["--lr-decay", "cosine", "--expansion", "8"], False, 6000),
     "mse_6000_cosine_expansion_32": ("mse_6000_cosine at twice the width (expansion 32: 512 channels; session 19)",
                                      MSE + ["--lr-decay", "cosine", "--expansion", "32"], False, 6000),
+    "mse_6000_cosine_terms": ("mse_6000_cosine reading the transport terms Ie, Ia, Ic beside their toned sum "
+                              "(--inputs terms; session 20)", MSE + ["--lr-decay", "cosine", "--inputs", "terms"],
+                              False, 6000),
     # Whole-view training (InstanceNorm sees the statistics it sees at inference; no crops): a
     # 128² step costs ~16 crop steps, so 750 steps are twice the preset's pixels.
     "mse_750_cosine_whole_view": ("latent MSE on the whole view (no crops), 750 steps, lr falling along a half "

@@ -278,21 +278,22 @@ class OneProcessTest(unittest.TestCase):
             cli = os.path.join(d, "cli")
             shutil.copytree(fit, cli)
             latentpt.refine(fit, note=lambda t: None, iterations=7, crop=6, lr=2e-3, lr_decay="cosine",
-                            dropout=0.0, expansion=2, patience=0, seed=5, arch="unet")
+                            dropout=0.0, expansion=2, patience=0, seed=5, arch="unet", inputs="terms")
             with open(os.path.join(fit, "refiner_loss.csv")) as f:
                 self.assertEqual(len(f.readlines()), 1 + 7)
             binary = os.environ.get("LATENTPT_BIN")
             if binary:
                 subprocess.run([binary, "refine", cli, "-q", "--iterations", "7", "--crop", "6", "--lr", "0.002",
                                 "--lr-decay", "cosine", "--dropout", "0", "--expansion", "2", "--patience", "0",
-                                "--seed", "5", "--arch", "unet"], check=True, stdout=subprocess.DEVNULL)
+                                "--seed", "5", "--arch", "unet", "--inputs", "terms"],
+                               check=True, stdout=subprocess.DEVNULL)
                 with open(os.path.join(fit, "refiner.pt"), "rb") as a, open(os.path.join(cli, "refiner.pt"), "rb") as b:
                     self.assertEqual(a.read(), b.read())
             with self.assertRaises(TypeError):
                 latentpt.refine(fit, crops=4)
             for bad, name in (({"dropout": 1.5}, "dropout"), ({"lr_decay": "linear"}, "lr_decay"),
                               ({"iterations": 0}, "iterations"), ({"augment": "turn"}, "turn"),
-                              ({"arch": "mlp"}, "arch")):
+                              ({"arch": "mlp"}, "arch"), ({"inputs": "rgb"}, "inputs")):
                 with self.assertRaises(ValueError) as e:
                     latentpt.refine(fit, note=lambda t: None, **bad)
                 self.assertIn(name, str(e.exception))
