@@ -49,12 +49,12 @@ expect_error "latent.exr" "$bin" refine "$out" -q
 # A fit folder in use by another process (here util-linux flock holds its lock) is refused at once.
 if command -v flock >/dev/null; then
     mkdir -p "$out/busy"
-    flock "$out/busy/.latentpt.lock" sleep 5 &
+    flock "$out/busy/.latentpt.lock" sleep 120 &  # long enough on a loaded machine; killed below
     holder=$!
     sleep 0.5
     expect_error "in use by another latentpt process" "$bin" fit "$scene" --synthetic-res 8x8 --iterations 2 -q --no-refiner --out "$out/busy"
     expect_error "in use by another latentpt process" "$bin" refine "$out/busy" -q
-    kill $holder 2>/dev/null; wait $holder 2>/dev/null
+    pkill -P $holder 2>/dev/null; kill $holder 2>/dev/null; wait $holder 2>/dev/null
 fi
 
 # An edit sequence split into frame ranges gives byte-identical files to one job (issue 20).
@@ -142,6 +142,17 @@ if [ -d "$shared/models/taesd3" ]; then
     check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
     check oiiotool "$out/ed/frame_0000_refined.exr" "$out/enc/latent_refined.exr" --fail 0 --failpercent 0 --diff
     check test -s "$out/ed/frame_0000.png"; check test -s "$out/ed/frame_0000_rendered.png"
+    # A refiner reading the transport terms (--inputs terms): an identity edit renders them exactly
+    # as the fit wrote them (latent_e/a/c.exr), so it reproduces the refined latent too.
+    cp -r "$out/enc" "$out/enc_terms"
+    "$bin" refine "$out/enc_terms" --iterations 4 --expansion 1 -q --inputs terms
+    check grep -q '"inputs": "terms"' "$out/enc_terms/metrics.json"
+    "$bin" render "$out/enc_terms" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed_terms"
+    check oiiotool "$out/ed_terms/frame_0000_refined.exr" "$out/enc_terms/latent_refined.exr" --fail 0 --failpercent 0 --diff
+    check sh -c "! cmp -s '$out/ed_terms/frame_0000_refined.exr' '$out/ed/frame_0000_refined.exr'"
+    expect_error "--inputs" "$bin" refine "$out/enc_terms" --iterations 4 --expansion 1 -q --resume
+    rm "$out/enc_terms/latent_c.exr"
+    expect_error "latent_c.exr" "$bin" refine "$out/enc_terms" --iterations 4 --expansion 1 -q --inputs terms
     # Another latent resolution than training: the refiner is fully convolutional.
     "$bin" render "$out/enc" --edit "$out/identity.json" --res 4x3 --spp 2 -q --out "$out/ed_res"
     check test "$(oiiotool --info "$out/ed_res/frame_0000_refined.exr" | grep -c ' 4 x  *3,')" -eq 1
