@@ -71,7 +71,9 @@ def main():
     p.add_argument("--scene-dir", required=True)
     p.add_argument("--seed-dir", required=True, help="folder (in --scene-dir) of the second-seed edit runs")
     p.add_argument("--seed", type=int, default=1, help="the second references' --ref-seed")
-    p.add_argument("--fit", default="eac", help="the fit whose edit folders hold the decoded frames")
+    p.add_argument("--folder", default="{seq}_eac",
+                   help="edit folder (in --scene-dir) of each sequence holding the decoded frames; {seq} = its name")
+    p.add_argument("--report", default="reference_noise", help="report name (.md and .json in the seed dir)")
     p.add_argument("--sequences", default="camera,object,light")
     p.add_argument("--frames", default="0,15,30,45")
     p.add_argument("--size", type=int, default=1024, help="reference width = height")
@@ -101,7 +103,7 @@ def main():
             rows = []
             for f in frames:
                 s1, r1, r2, rbar, r12 = refs_of(seq, f)
-                folder = os.path.join(a.scene_dir, f"{seq}_{a.fit}")
+                folder = os.path.join(a.scene_dir, a.folder.format(seq=seq))
                 row = {"frame": f, "sigma2_x100": 0.5 * r12}
                 for kind, png in (("refined", f"frame_{f:04d}.png"), ("rendered", f"frame_{f:04d}_rendered.png")):
                     row[kind] = frame_row(m, os.path.join(folder, png), r1, r2, rbar, r12)
@@ -120,7 +122,8 @@ def main():
 
 
 def write_report(out, a, result):
-    lines = [f"# Reference noise on {a.scene_dir} ({a.ref_spp}-spp references, seeds 0x5eed and {a.seed})", "",
+    lines = [f"# Reference noise on {a.scene_dir}/{a.folder} ({a.ref_spp}-spp references, seeds 0x5eed and {a.seed})",
+             "",
              "Mean over frames " + a.frames + ". MSE×100: against the experiment's reference r₁ (the table's), "
              "noise-corrected (an estimate against the converged view), and the references' own variance σ²×100. "
              "LPIPS against r₁ and against the mean of both references (twice the spp).", "",
@@ -136,7 +139,7 @@ def write_report(out, a, result):
     lines += ["", f"VAE round trip of the training view: MSE×100 {fl['mse_r1']:.4f} against r₁, "
               f"{fl['mse_r2_corrected']:.4f} noise-corrected; LPIPS {fl['lpips_r1']:.4f} against r₁, "
               f"{fl['lpips_r2']:.4f} against r₂; σ²×100 {fl['sigma2_x100']:.4f}.", ""]
-    for name, text in (("reference_noise.json", json.dumps(result, indent=1)), ("reference_noise.md", "\n".join(lines))):
+    for name, text in ((a.report + ".json", json.dumps(result, indent=1)), (a.report + ".md", "\n".join(lines))):
         tmp = os.path.join(out, name + ".tmp")
         with open(tmp, "w") as fh:
             fh.write(text)
