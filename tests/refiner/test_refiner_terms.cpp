@@ -78,8 +78,9 @@ TEST(Refiner, TermsInputLearnsWhatOnlyTheTermsCarry) {
     plain->train(views, nullptr, nullptr, po);
     const double with_terms = channel_mse(terms->refine(test.in), test.target, 3);
     const double without = channel_mse(plain->refine(test.in), test.target, 3);
-    std::cout << "test-view MSE of channel 3: with terms " << with_terms << ", without " << without << " (all: "
-              << mse(terms->refine(test.in), test.target) << ", " << mse(plain->refine(test.in), test.target) << ")\n";
+    std::cout << "test-view MSE of channel 3: with terms " << with_terms << ", without " << without
+              << " (all: " << mse(terms->refine(test.in), test.target) << ", "
+              << mse(plain->refine(test.in), test.target) << ")\n";
     EXPECT_GT(without, 0.06);
     EXPECT_LT(with_terms, 0.2 * without) << "with terms " << with_terms << ", without " << without;
 
