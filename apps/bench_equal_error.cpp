@@ -87,7 +87,7 @@ int run_bench_equal_error(const BenchArgs& a) {
         throw std::runtime_error(a.equal_error + ": target.exr / reference_rgb.exr do not match the fit's latent size");
     auto vae = pipeline::open_vae(fit.vae);
     const SceneSpectra<3> rgb_spectra = SceneSpectra<3>::from_description(*fit.scene);
-    const uint64_t seed = 1;  // the reference used 0x5eed: independent samples
+    const uint64_t seed = 1;  // the reference used pipeline::kReferenceSeed: independent samples
 
     std::printf("%s: %dx%d latents (%dx%d RGB); errors against the fit's reference\n", a.equal_error.c_str(), w, h, W,
                 H);

@@ -23,8 +23,8 @@ struct EditJob {
     uint64_t seed = 0;  ///< frame i uses seed + i
     bool reference = false;
     int ref_spp = 256;
-    /// The references' seed: another one path traces
-    /// independent references of the same frames, to measure their noise (docs/metrics.md).
+    /// The references' seed: another one traces independent references of the same frames, to
+    /// measure their noise (docs/metrics.md "Reference noise").
     uint64_t ref_seed = kReferenceSeed;
     std::string reference_cache;  ///< keeps path-traced reference frames for reuse
     /// Only frames first_frame..last_frame (inclusive; -1 = the last): a sequence split into jobs
