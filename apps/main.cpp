@@ -231,8 +231,9 @@ struct Cli {
             ->capture_default_str();
         fit->add_option(
                "--param", f.job.param,
-               "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative)")
-            ->check(CLI::IsMember({"code", "paper", "classic"}))
+               "parameterisation: code (public code), paper (paper text), classic (the baseline: non-negative), "
+               "gain (code with a learnable gain on each emitter's Le)")
+            ->check(CLI::IsMember({"code", "paper", "classic", "gain"}))
             ->capture_default_str();
         fit->add_option("--gate", f.job.gate, "Ic gate: shadowed (1 - V) or visible (V)")
             ->check(CLI::IsMember({"shadowed", "visible"}))

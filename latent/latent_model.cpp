@@ -9,7 +9,8 @@ Parameterisation parameterisation_from_string(const std::string& s) {
     if (s == "paper") return Parameterisation::Paper;
     if (s == "code") return Parameterisation::Code;
     if (s == "classic") return Parameterisation::Classic;
-    throw std::invalid_argument("unknown parameterisation '" + s + "' (known: paper, code, classic)");
+    if (s == "gain") return Parameterisation::Gain;
+    throw std::invalid_argument("unknown parameterisation '" + s + "' (known: paper, code, classic, gain)");
 }
 
 namespace {
@@ -21,7 +22,7 @@ struct SliceSpec {
 
 /// docs/params.md: the two parameterisations, per kind of vector.
 SliceSpec spec_for(Parameterisation p, bool reflectance_like) {
-    if (p == Parameterisation::Code)
+    if (p == Parameterisation::Code || p == Parameterisation::Gain)
         return reflectance_like ? SliceSpec{ParamMap::Sigmoid, -1e30f, 1e30f, -1.f, 1.f}
                                 : SliceSpec{ParamMap::Identity, -6.f, 6.f, -0.1f, 0.1f};
     if (p == Parameterisation::Classic)  // non-negative; radiances start small so the render starts inside (0, 1)
@@ -38,8 +39,9 @@ LatentModel::LatentModel(const Scene& scene, Parameterisation p, uint64_t seed) 
     m_slots.resize(m_scene.shapes.size());
     auto add = [&](const std::string& name, const std::string& kind, bool refl) {
         SliceSpec s = spec_for(p, refl);
-        int i = m_params.add(name, kind, s.map, kLatentChannels, s.lo, s.hi);
-        return i;
+        // docs/params.md (4): Gain is Code with one learnable log-gain on each emitter's L̃e
+        const ParamMap map = p == Parameterisation::Gain && kind == "Le" ? ParamMap::Gain : s.map;
+        return m_params.add(name, kind, map, kLatentChannels, s.lo, s.hi);
     };
     for (size_t i = 0; i < m_scene.shapes.size(); ++i) {
         const Shape& shape = m_scene.shapes[i];

@@ -22,9 +22,12 @@ namespace lpt {
 /// vector: sigmoid in both, initialised at the scene file's value.
 /// Paper / Code: the two signed parameterisations; Classic: the paper's baseline, every vector
 /// non-negative (reflectances sigmoid in (0, 1), radiances clamped to [0, 1e4]) for a classic
-/// render in [0, 1) that the logit tone curve maps to latent space. docs/params.md.
-enum class Parameterisation { Paper, Code, Classic };
-Parameterisation parameterisation_from_string(const std::string& s);  ///< "paper" | "code" | "classic"
+/// render in [0, 1) that the logit tone curve maps to latent space. Gain: Code, but each
+/// emitter's L̃e = e^g · u with u in [−6, 6] and one learnable log-gain g (starts at 0, so the
+/// first render is Code's): a light that reaches the image only after bounces needs far more than
+/// 6. docs/params.md.
+enum class Parameterisation { Paper, Code, Classic, Gain };
+Parameterisation parameterisation_from_string(const std::string& s);  ///< "paper" | "code" | "classic" | "gain"
 
 class LatentModel {
 public:

@@ -15,6 +15,8 @@ const char* to_string(ParamMap m) {
             return "sigmoid";
         case ParamMap::PosNeg:
             return "posneg";
+        case ParamMap::Gain:
+            return "gain";
     }
     return "?";
 }
@@ -23,7 +25,8 @@ ParamMap param_map_from_string(const std::string& s) {
     if (s == "identity") return ParamMap::Identity;
     if (s == "sigmoid") return ParamMap::Sigmoid;
     if (s == "posneg") return ParamMap::PosNeg;
-    throw std::invalid_argument("unknown parameter map '" + s + "' (known: identity, sigmoid, posneg)");
+    if (s == "gain") return ParamMap::Gain;
+    throw std::invalid_argument("unknown parameter map '" + s + "' (known: identity, sigmoid, posneg, gain)");
 }
 
 int ParamStore::add(const std::string& name, const std::string& kind, ParamMap map, int channels, float lo, float hi) {
@@ -54,9 +57,34 @@ int ParamStore::find(const std::string& name) const {
     return -1;
 }
 
+namespace {
+
+/// docs/params.md (4): the smallest log-gain g >= 0 that brings every v / e^g inside [lo, hi].
+void set_gain_value(const ParamSlice& s, const float* v, float* r) {
+    float need = 1.f;
+    for (int c = 0; c < s.channels; ++c) {
+        if (!std::isfinite(v[c])) throw std::invalid_argument("parameter '" + s.name + "': value not finite");
+        if (v[c] > 0.f && s.hi > 0.f) need = std::max(need, v[c] / s.hi);
+        if (v[c] < 0.f && s.lo < 0.f) need = std::max(need, v[c] / s.lo);
+        if ((v[c] > 0.f && s.hi <= 0.f) || (v[c] < 0.f && s.lo >= 0.f))
+            throw std::invalid_argument("parameter '" + s.name + "': value outside its range");
+    }
+    const float g = std::log(need);
+    if (g > kGainHi) throw std::invalid_argument("parameter '" + s.name + "': value beyond the largest gain");
+    for (int c = 0; c < s.channels; ++c) r[c] = std::clamp(v[c] / need, s.lo, s.hi);
+    r[s.channels] = g;
+}
+
+}  // namespace
+
 void ParamStore::set_value(int i, const float* v) {
     const ParamSlice& s = m_slices[i];
     float* r = m_raw.data() + s.raw_offset;
+    if (s.map == ParamMap::Gain) {
+        set_gain_value(s, v, r);
+        update_values();
+        return;
+    }
     for (int c = 0; c < s.channels; ++c) {
         switch (s.map) {
             case ParamMap::Identity:
@@ -77,6 +105,8 @@ void ParamStore::set_value(int i, const float* v) {
                 r[c + s.channels] = neg + s.lo;
                 break;
             }
+            case ParamMap::Gain:
+                break;  // handled above
         }
     }
     update_values();
@@ -86,6 +116,8 @@ void ParamStore::update_values() {
     for (const ParamSlice& s : m_slices) {
         const float* r = m_raw.data() + s.raw_offset;
         float* v = m_value.data() + s.value_offset;
+        // docs/params.md (4): one gain for the whole vector
+        const float gain = s.map == ParamMap::Gain ? std::exp(r[s.channels]) : 1.f;
         for (int c = 0; c < s.channels; ++c) {
             switch (s.map) {
                 case ParamMap::Identity:
@@ -99,6 +131,9 @@ void ParamStore::update_values() {
                 case ParamMap::PosNeg:
                     v[c] = r[c] - r[c + s.channels];
                     break;
+                case ParamMap::Gain:
+                    v[c] = gain * r[c];
+                    break;
             }
         }
     }
@@ -109,6 +144,8 @@ void ParamStore::backward() {
         const float* v = m_value.data() + s.value_offset;
         const float* gv = m_grad_value.data() + s.value_offset;
         float* gr = m_grad_raw.data() + s.raw_offset;
+        const float gain = s.map == ParamMap::Gain ? std::exp(m_raw[s.raw_offset + s.channels]) : 1.f;
+        if (s.map == ParamMap::Gain) gr[s.channels] = 0.f;
         for (int c = 0; c < s.channels; ++c) {
             switch (s.map) {
                 case ParamMap::Identity:
@@ -120,6 +157,11 @@ void ParamStore::backward() {
                 case ParamMap::PosNeg:
                     gr[c] = gv[c];
                     gr[c + s.channels] = -gv[c];
+                    break;
+                // docs/params.md (4): ∂v_c/∂u_c = e^g, ∂v_c/∂g = v_c
+                case ParamMap::Gain:
+                    gr[c] = gv[c] * gain;
+                    gr[s.channels] += gv[c] * v[c];
                     break;
             }
         }
@@ -135,7 +177,9 @@ void ParamStore::clamp_raw() {
     for (const ParamSlice& s : m_slices) {
         if (s.map == ParamMap::Sigmoid) continue;  // unbounded raw by design
         float* r = m_raw.data() + s.raw_offset;
-        for (size_t k = 0; k < s.raw_size(); ++k) r[k] = std::clamp(r[k], s.lo, s.hi);
+        const size_t vector_size = s.map == ParamMap::Gain ? size_t(s.channels) : s.raw_size();
+        for (size_t k = 0; k < vector_size; ++k) r[k] = std::clamp(r[k], s.lo, s.hi);
+        if (s.map == ParamMap::Gain) r[s.channels] = std::clamp(r[s.channels], kGainLo, kGainHi);
     }
     update_values();
 }
@@ -144,8 +188,10 @@ void ParamStore::init_uniform(const std::string& kind, float a, float b, uint64_
     for (size_t i = 0; i < m_slices.size(); ++i) {
         const ParamSlice& s = m_slices[i];
         if (s.kind != kind) continue;
-        for (size_t k = 0; k < s.raw_size(); ++k)
+        const size_t vector_size = s.map == ParamMap::Gain ? size_t(s.channels) : s.raw_size();
+        for (size_t k = 0; k < vector_size; ++k)
             m_raw[s.raw_offset + k] = a + (b - a) * sample_1d(seed, uint32_t(i), uint32_t(k), 0);
+        if (s.map == ParamMap::Gain) m_raw[s.raw_offset + s.channels] = 0.f;
     }
     clamp_raw();
 }

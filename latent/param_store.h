@@ -14,7 +14,12 @@ enum class ParamMap {
     Identity,  ///< value = raw; raw clamped to [lo, hi] after each step (public code: [-6, 6])
     Sigmoid,   ///< value = 1 / (1 + exp(-raw)) (public code's reflectances)
     PosNeg,    ///< value = pos - neg, both raw parts clamped to [lo, hi] (paper text: [0, hi])
+    Gain,      ///< value = exp(g) * u: raw = (u, g), u clamped to [lo, hi], one log-gain g in [kGainLo, kGainHi]
 };
+
+/// Range of a Gain slice's log-gain: e^12 ≈ 1.6e5 lets an emitter whose light reaches the image
+/// only after bounces grow far past the [-6, 6] of its vector (docs/params.md (4)).
+constexpr float kGainLo = -12.f, kGainHi = 12.f;
 
 const char* to_string(ParamMap m);
 ParamMap param_map_from_string(const std::string& s);  ///< throws std::invalid_argument
@@ -27,7 +32,9 @@ struct ParamSlice {
     size_t raw_offset = 0;  ///< PosNeg holds `channels` pos entries then `channels` neg entries
     size_t value_offset = 0;
     float lo = -6.f, hi = 6.f;
-    size_t raw_size() const { return map == ParamMap::PosNeg ? 2 * size_t(channels) : size_t(channels); }
+    size_t raw_size() const {
+        return map == ParamMap::PosNeg ? 2 * size_t(channels) : size_t(channels) + (map == ParamMap::Gain ? 1 : 0);
+    }
 };
 
 class ParamStore {
@@ -57,7 +64,8 @@ public:
     void zero_grad();
     /// Projects raw back into each slice's [lo, hi] (after an optimiser step).
     void clamp_raw();
-    /// Uniform random raw values in [a, b] for every slice of `kind` (deterministic in seed).
+    /// Uniform random raw values in [a, b] for every slice of `kind` (deterministic in seed); a Gain
+    /// slice's log-gain starts at 0, so its initial values are those of an Identity slice.
     void init_uniform(const std::string& kind, float a, float b, uint64_t seed);
 
     /// Human-readable JSON: {"slices": [{"name", "kind", "map", "lo", "hi", "raw": [...], "value": [...]}]}.

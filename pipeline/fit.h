@@ -31,7 +31,7 @@ struct FitJob {
 
     // The model and its optimisation. options.seed seeds the parameters, every iteration's paths,
     // the final render (seed + 1) and the refiner; options.checkpoint_dir is <out>/checkpoint.
-    std::string param = "code";     ///< parameterisation: code, paper, classic
+    std::string param = "code";     ///< parameterisation: code, paper, classic, gain
     std::string gate = "shadowed";  ///< Ĩc gate: shadowed (1 − V) or visible (V)
     std::string terms = "eac";      ///< latent terms rendered: any of e, a, c
     FitOptions options;

@@ -85,6 +85,8 @@ def main():
     ap.add_argument("--refiner-iterations", type=int, default=None)
     ap.add_argument("--frame-step", type=int, default=None, help="evaluate every N-th frame of each edit sequence (default 1)")
     ap.add_argument("--spp", type=int, default=64, help="latent samples per pixel of the edited frames")
+    ap.add_argument("--param", choices=["code", "gain"], default=None,
+                    help="every ablation fit's --param (default: the preset's, else code; docs/params.md (4))")
     ap.add_argument("--emission-decay", type=float, default=None,
                     help="every fit's --emission-decay (default: the preset's, else 0; docs/fitting.md (17))")
     ap.add_argument("--emitter-response-decay", type=float, default=None,
@@ -100,7 +102,7 @@ def main():
     c = X.settings(quick=a.quick, scenes=a.scenes.split(",") if a.scenes else None, out=a.out, bin=a.bin,
                    shared=a.shared, image_res=a.image_res, frames=a.frames, ref_spp=a.ref_spp,
                    fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk,
-                   paper=a.paper, frame_step=a.frame_step, emission_decay=a.emission_decay,
+                   paper=a.paper, frame_step=a.frame_step, emission_decay=a.emission_decay, param=a.param,
                    emitter_response_decay=a.emitter_response_decay)
     for s in c["scenes"]:
         if s not in X.SCENES:

@@ -161,7 +161,8 @@ def write_outputs(out, c, summary, failures, timings):
           f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
           "reference spp per scene below, "
           f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}), "
-          f"emission decay {c.get('emission_decay', 0):g}, emitter response decay {c.get('emitter_response_decay', 0):g}, frames {frames or 'as in the edit files'}"
+          f"parameterisation {c.get('param', 'code')}, emission decay {c.get('emission_decay', 0):g}, "
+          f"emitter response decay {c.get('emitter_response_decay', 0):g}, frames {frames or 'as in the edit files'}"
           f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp", ""]
     for scene, s in summary.items():
         t = s["training_view"]
@@ -276,7 +277,7 @@ PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
              fit_iterations=None, refiner_iterations=None, spp=64, chunk=8, paper=False, frame_step=None,
-             emission_decay=None, emitter_response_decay=None):
+             emission_decay=None, emitter_response_decay=None, param=None):
     """The workflow's config (JSON-able): --quick's small sizes, --paper's preset or the full run's;
     flags given explicitly win over the preset's values."""
     p = PAPER if paper else {}
@@ -290,6 +291,7 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "refiner_iterations": refiner_iterations or p.get("refiner_iterations") or (300 if quick else 3000),
             "refiner_lr_decay": p.get("refiner_lr_decay", "none"), "emission_decay": p.get("emission_decay", 0) if emission_decay is None else emission_decay,
             "emitter_response_decay": p.get("emitter_response_decay", 0) if emitter_response_decay is None else emitter_response_decay,
+            "param": p.get("param", "code") if param is None else param,
             "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
             "ref_spp": ref_spp or p.get("ref_spp") or (32 if quick else None),
             "training_ref_spp": p.get("training_ref_spp"), "fits": p.get("fits", list(FITS)), "spp": spp,
@@ -385,6 +387,9 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
         cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     if decay and c.get("emitter_response_decay", 0):
         cmd += ["--emitter-response-decay", repr(float(c["emitter_response_decay"]))]
+    # named only when not the default, and never over a fit's own (the baseline's classic)
+    if c.get("param", "code") != "code" and "--param" not in extra:
+        cmd += ["--param", c["param"]]
     for define in SCENES[scene][1]:
         cmd += ["-D", define]
     return cmd

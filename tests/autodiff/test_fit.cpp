@@ -173,14 +173,19 @@ TEST(Fit, NonFiniteStepsAreRefusedNamedAndLeaveTheParameters) {
 namespace {
 
 /// A penalty's raw gradient (value gradient mapped by ParamStore::backward) against central
-/// differences of the penalty itself, for the identity and the pos − neg maps; the slices
+/// differences of the penalty itself, for the identity, pos − neg and gain maps; the slices
 /// `penalised` names must have gradients, all others none.
 void expect_penalty_gradient_matches_differences(const std::function<double(ParamStore&)>& penalty,
                                                  const std::function<bool(const ParamSlice&)>& penalised) {
-    for (Parameterisation p : {Parameterisation::Code, Parameterisation::Paper}) {
+    for (Parameterisation p : {Parameterisation::Code, Parameterisation::Paper, Parameterisation::Gain}) {
         Scene scene = cornell();
         LatentModel m(scene, p, 3);
         ParamStore& ps = m.params();
+        const int le = ps.find("light.Le");
+        if (ps.slice(le).map == ParamMap::Gain) {  // a log-gain away from 0, where ∂v/∂u = e^g ≠ 1
+            ps.raw()[ps.slice(le).raw_offset + ps.slice(le).channels] = 0.4f;
+            ps.update_values();
+        }
         ps.zero_grad();
         const double at = penalty(ps);
         ps.backward();
@@ -199,7 +204,8 @@ void expect_penalty_gradient_matches_differences(const std::function<double(Para
                 };
                 const double fd = (penalty_at(keep + h) - penalty_at(keep - h)) / (2 * h);
                 penalty_at(keep);
-                // Quadratic in the values, values affine in raw for these maps: exact up to rounding.
+                // Quadratic in the values, values affine in raw (gain: exponential in g, whose
+                // central difference is off by ~h²/6 relatively): exact up to rounding.
                 EXPECT_NEAR(grad[r], fd, 1e-4 + 1e-3 * std::abs(fd)) << sl.name << " raw " << r - sl.raw_offset;
                 if (penalised(sl)) ++penalised_entries;
                 else EXPECT_EQ(grad[r], 0.f) << sl.name;
@@ -213,7 +219,7 @@ void expect_penalty_gradient_matches_differences(const std::function<double(Para
 
 }  // namespace
 
-TEST(EmissionDecay, GradientMatchesCentralDifferencesInBothParameterisations) {
+TEST(EmissionDecay, GradientMatchesCentralDifferencesInEveryParameterisation) {
     expect_penalty_gradient_matches_differences([](ParamStore& ps) { return add_emission_decay(ps, 0.3f); },
                                                 [](const ParamSlice& sl) { return sl.kind == "Le"; });
 }
@@ -278,4 +284,44 @@ TEST(EmitterResponseDecay, PinsTheLightsResponsesNotItsEmission) {
     EXPECT_LT(pinned.light_responses2, 0.25 * free.light_responses2);
     EXPECT_GT(pinned.le2, 0.5 * free.le2);
     EXPECT_LT(pinned.loss, 1.5 * free.loss);
+}
+
+TEST(Fit, GainReachesALightFarBeyondTheCodeClamp) {
+    // Target: Ĩe of a model whose light is 40x a vector inside [-1, 1], far past Code's [-6, 6]
+    // (more than the reflectances, at most 1 instead of the truth's ~0.5, can make up for).
+    Scene ts = cornell();
+    LatentModel truth(ts, Parameterisation::Gain, 1);
+    const int le = truth.params().find("light.Le");
+    std::vector<float> bright(kLatentChannels);
+    for (int c = 0; c < kLatentChannels; ++c) bright[c] = 40.f * (c % 2 ? -1.f : 1.f) * (0.5f + 0.03f * c);
+    truth.params().set_value(le, bright.data());
+    truth.sync();
+    truth.terms().ambient = truth.terms().occlusion = false;  // only L̃e can make the room bright
+    const std::vector<float> target = render_toned(truth, target_options(ts, 256, 99), ToneCurve::Clip);
+    double floor = 0;  // the truth itself at the fit's 4 spp
+    for (uint64_t s = 0; s < 8; ++s) {
+        auto img = render_toned(truth, target_options(ts, 4, 4000 + s), ToneCurve::Clip);
+        floor += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
+    }
+    auto fit = [&](Parameterisation p) {
+        Scene scene = cornell();
+        LatentModel m(scene, p, 2);
+        m.terms().ambient = m.terms().occlusion = false;
+        fit_latent(m, target, kRes, kRes, fit_options(300));
+        double loss = 0;
+        for (uint64_t s = 0; s < 8; ++s) {
+            auto img = render_toned(m, target_options(scene, 4, 4000 + s), ToneCurve::Clip);
+            loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
+        }
+        const float gain = m.params().value(le)[0] / bright[0];
+        std::cout << (p == Parameterisation::Gain ? "gain" : "code") << ": loss " << loss << " (floor " << floor
+                  << "), light channel 0 at " << gain << " of the truth's\n";
+        return std::pair{loss, gain};
+    };
+    const auto [code_loss, code_ratio] = fit(Parameterisation::Code);
+    const auto [gain_loss, gain_ratio] = fit(Parameterisation::Gain);
+    EXPECT_LE(code_ratio, 6.f / bright[0] + 1e-6f);  // held inside the clamp
+    EXPECT_GT(gain_ratio, 6.f / bright[0]);          // grown past it
+    EXPECT_LT(gain_loss, 1.2 * floor);               // recovered: at the noise floor
+    EXPECT_GT(code_loss, 2.0 * floor);               // cannot get there
 }

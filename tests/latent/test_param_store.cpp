@@ -11,9 +11,13 @@ ParamStore make_store() {
     ps.add("a.La", "La", ParamMap::Identity, 4, -6.f, 6.f);
     ps.add("a.bsdf.reflectance", "reflectance", ParamMap::Sigmoid, 4, -1e9f, 1e9f);
     ps.add("a.Lc", "Lc", ParamMap::PosNeg, 4, 0.f, 1.f);
+    ps.add("a.Le", "Le", ParamMap::Gain, 4, -6.f, 6.f);
     ps.init_uniform("La", -1.f, 1.f, 1);
     ps.init_uniform("reflectance", -2.f, 2.f, 2);
     ps.init_uniform("Lc", 0.f, 1.f, 3);
+    ps.init_uniform("Le", -1.f, 1.f, 4);
+    ps.raw()[ps.slice(3).raw_offset + 4] = 0.7f;  // a log-gain away from 0, so ∂v/∂u ≠ 1
+    ps.update_values();
     return ps;
 }
 }  // namespace
@@ -47,7 +51,7 @@ TEST(ParamStore, BackwardMatchesFiniteDifferencesOfEveryMap) {
 TEST(ParamStore, SetValueRoundTripsThroughEveryMap) {
     ParamStore ps = make_store();
     const float v[4] = {-0.5f, 0.f, 0.25f, 0.9f};
-    for (int s : {0, 2}) {
+    for (int s : {0, 2, 3}) {
         ps.set_value(s, v);
         for (int c = 0; c < 4; ++c) EXPECT_NEAR(ps.value(s)[c], v[c], 1e-6f);
     }
@@ -57,6 +61,13 @@ TEST(ParamStore, SetValueRoundTripsThroughEveryMap) {
     const float bad[4] = {1.5f, 0.f, 0.f, 0.f};
     EXPECT_THROW(ps.set_value(1, bad), std::invalid_argument);  // sigmoid cannot reach 1.5
     EXPECT_THROW(ps.set_value(2, bad), std::invalid_argument);  // PosNeg parts limited to [0, 1]
+    // A gain slice reaches values far outside its vector's [-6, 6]: through its log-gain alone.
+    const float big[4] = {300.f, -45.f, 0.f, 2.f};
+    ps.set_value(3, big);
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(ps.value(3)[c], big[c], 1e-5f * 300.f);
+    EXPECT_NEAR(ps.raw()[ps.slice(3).raw_offset + 4], std::log(300.f / 6.f), 1e-5f);
+    const float beyond[4] = {6.f * std::exp(kGainHi + 1.f), 0.f, 0.f, 0.f};
+    EXPECT_THROW(ps.set_value(3, beyond), std::invalid_argument);
 }
 
 TEST(ParamStore, ClampKeepsRawInRange) {
@@ -64,8 +75,19 @@ TEST(ParamStore, ClampKeepsRawInRange) {
     for (float& r : ps.raw()) r = 100.f;
     ps.clamp_raw();
     EXPECT_FLOAT_EQ(ps.value(0)[0], 6.f);
-    EXPECT_FLOAT_EQ(ps.value(2)[0], 0.f);               // pos = neg = 1 after the clamp
-    EXPECT_GT(ps.raw()[ps.slice(1).raw_offset], 99.f);  // sigmoid raw is unbounded
+    EXPECT_FLOAT_EQ(ps.value(2)[0], 0.f);                      // pos = neg = 1 after the clamp
+    EXPECT_GT(ps.raw()[ps.slice(1).raw_offset], 99.f);         // sigmoid raw is unbounded
+    EXPECT_FLOAT_EQ(ps.value(3)[0], 6.f * std::exp(kGainHi));  // vector and log-gain at their limits
+}
+
+TEST(ParamStore, GainStartsAtOneSoItsFirstValuesAreIdentitys) {
+    ParamStore gain, identity;
+    gain.add("a.Le", "Le", ParamMap::Gain, 16, -6.f, 6.f);
+    identity.add("a.Le", "Le", ParamMap::Identity, 16, -6.f, 6.f);
+    gain.init_uniform("Le", -0.1f, 0.1f, 9);
+    identity.init_uniform("Le", -0.1f, 0.1f, 9);
+    EXPECT_EQ(gain.values(), identity.values());
+    EXPECT_EQ(gain.raw().back(), 0.f);
 }
 
 TEST(ParamStore, JsonRoundTripIsExact) {
