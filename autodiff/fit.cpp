@@ -26,11 +26,15 @@ RenderOptions iteration_options(const LatentModel& model, const FitOptions& o, i
 
 }  // namespace
 
-std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone) {
-    std::vector<float> img =
-        render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), options).sum();
+std::vector<float> toned_sum(const TermFilms<kLatentChannels>& films, ToneCurve tone) {
+    std::vector<float> img = films.sum();
     tone_map(tone, img.data(), img.data(), img.size());
     return img;
+}
+
+std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone) {
+    return toned_sum(render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), options),
+                     tone);
 }
 
 namespace {

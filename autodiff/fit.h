@@ -73,6 +73,10 @@ double add_emission_decay(ParamStore& params, float lambda);
 /// add_emission_decay.
 double add_emitter_response_decay(ParamStore& params, float mu);
 
+/// Ĩe + Ĩa + Ĩc of `films` with the tone curve applied: the one place the terms become the latent
+/// the loss, the refiner and the decoder see.
+std::vector<float> toned_sum(const TermFilms<kLatentChannels>& films, ToneCurve tone);
+
 /// Latent render with the fit's tone curve applied: what the loss compares with the target.
 std::vector<float> render_toned(const LatentModel& model, const RenderOptions& options, ToneCurve tone);
 

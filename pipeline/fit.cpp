@@ -138,8 +138,7 @@ double write_stage1(const FitJob& job, const LatentModel& model, const Target& t
     RenderOptions ro = RenderOptions::from_scene(model.scene(), w, h, job.final_spp, job.options.seed + 1);
     TermFilms<kLatentChannels> films =
         render_latent_terms<kLatentChannels>(model.scene(), model.spectra(), model.terms(), ro);
-    std::vector<float> linear = films.sum(), toned(linear.size());
-    tone_map(job.options.tone, linear.data(), toned.data(), linear.size());
+    const std::vector<float> toned = toned_sum(films, job.options.tone);
     const double final_loss = huber_loss(toned.data(), target.data.data(), toned.size(), 1.f, nullptr);
     write_text_atomic((out / "params.json").string(), model.params().to_json());
     write_text_atomic((out / "fit.json").string(), fit_manifest(job, w, h, final_loss, state).dump(2));

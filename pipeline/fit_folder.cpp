@@ -32,8 +32,7 @@ FitRender render_fit_terms(const FitFolder& fit, int w, int h, int spp, uint64_t
     const TermFilms<kLatentChannels> films = render_latent_terms<kLatentChannels>(
         model.scene(), model.spectra(), model.terms(), RenderOptions::from_scene(*fit.scene, w, h, spp, seed));
     FitRender r;
-    r.toned = films.sum();  // as render_toned: the sum, then the tone curve in place
-    tone_map(fit.tone, r.toned.data(), r.toned.data(), r.toned.size());
+    r.toned = toned_sum(films, fit.tone);
     r.terms = interleave_terms(films.e.develop(), films.a.develop(), films.c.develop(), kLatentChannels);
     return r;
 }
