@@ -68,8 +68,9 @@ class LatentTest(unittest.TestCase):
         with self.assertRaises(KeyError):
             self.model.value("no.such")
 
-    def test_adjoint_matches_central_differences(self):
-        m = self.model
+    def check_adjoint(self, m, entries):
+        """Raw gradient of a fixed linear functional of the linear latent against central
+        differences, at the raw entries `entries` ({slice name: offsets within its raw})."""
         rng = np.random.default_rng(1)
         w = rng.uniform(-1, 1, (m.height, m.width, 16)).astype(np.float32)
         # Before the tone curve: its x^(1/2.2) is singular at 0, where fresh L̃a values start.
@@ -78,9 +79,7 @@ class LatentTest(unittest.TestCase):
         raw0 = m.raw.copy()
         checked = 0
         for s in m.slices():
-            if s["name"] not in ("light.Le", "floor.La", "back.Lc", "red_wall.bsdf.reflectance", "background"):
-                continue
-            for k in (0, 5):
+            for k in entries.get(s["name"], ()):
                 i = s["raw_offset"] + k
                 h = 1e-2
                 up, down = raw0.copy(), raw0.copy()
@@ -94,7 +93,23 @@ class LatentTest(unittest.TestCase):
                 self.assertLess(abs(grad[i] - fd), 2e-2 * max(1.0, abs(fd)), f"{s['name']}[{k}]: adjoint {grad[i]} fd {fd}")
                 checked += 1
         m.raw = raw0
-        self.assertGreaterEqual(checked, 8)
+        self.assertEqual(checked, sum(len(v) for v in entries.values()))
+
+    def test_adjoint_matches_central_differences(self):
+        names = ("light.Le", "floor.La", "back.Lc", "red_wall.bsdf.reflectance", "background")
+        self.check_adjoint(self.model, {n: (0, 5) for n in names})
+
+    def test_gain_adjoint_matches_central_differences(self):
+        """param="gain" (docs/params.md (4)): the light's L̃e = e^g·u; raw entry 16 is g."""
+        m = latentpt.LatentScene(latentpt.Scene(BOX, defines=SMOOTH), param="gain", seed=3)
+        le = next(s for s in m.slices() if s["name"] == "light.Le")
+        self.assertEqual((le["map"], le["raw_size"]), ("gain", 17))
+        raw = m.raw.copy()
+        raw[le["raw_offset"] + 16] = 0.5  # away from g = 0, where ∂v/∂u = 1
+        m.raw = raw
+        np.testing.assert_allclose(m.value("light.Le"), np.exp(0.5) * raw[le["raw_offset"]:le["raw_offset"] + 16],
+                                   rtol=1e-6)
+        self.check_adjoint(m, {"light.Le": (0, 5, 16), "floor.La": (0,)})
 
     def test_torch_function_backward_is_the_adjoint(self):
         torch = torch_or_skip()
