@@ -1,5 +1,6 @@
 #include "pipeline/fit_checkpoint.h"
 #include "core/image_io.h"
+#include "pipeline/fit_folder.h"
 #include <filesystem>
 #include <stdexcept>
 
@@ -9,33 +10,25 @@ namespace fs = std::filesystem;
 
 nlohmann::json stage1_settings(const FitJob& job) {
     const FitOptions& o = job.options;
-    nlohmann::json settings = {{"scene", fs::absolute(job.scene).string()},
-                               {"defines", job.defines},
-                               {"target", job.target.empty() ? "" : fs::absolute(job.target).string()},
-                               {"encode", job.encode},
-                               {"encode_res", job.encode_res},
-                               {"ref_spp", job.ref_spp},
-                               {"ref_tone", job.ref_tone},
-                               {"synthetic_res", job.synthetic_res},
-                               {"synthetic_seed", job.synthetic_seed},
-                               {"param", job.param},
-                               {"gate", job.gate},
-                               {"terms", job.terms},
-                               {"seed", o.seed},
-                               {"spp", o.spp},
-                               {"lr", o.lr},
-                               {"lr_min", o.lr_min},
-                               {"lr_period", o.lr_period},
-                               {"lr_t_mult", o.lr_t_mult},
-                               {"huber_delta", o.huber_delta},
-                               {"emission_decay", o.emission_decay},
-                               {"emitter_response_decay", o.emitter_response_decay},
-                               {"tone", to_string(o.tone)},
-                               {"patience", o.patience},
-                               {"min_delta", o.min_delta},
-                               {"smoothing", o.smoothing},
-                               {"reuse_paths", o.reuse_paths}};
-    if (job.sampler) settings["sampler"] = sampler_name(*job.sampler);  // absent: the scene's, as before
+    nlohmann::json settings = fit_model_settings(job);  // the model's own, as fit.json records them
+    settings.update({{"target", job.target.empty() ? "" : fs::absolute(job.target).string()},
+                     {"encode", job.encode},
+                     {"encode_res", job.encode_res},
+                     {"ref_spp", job.ref_spp},
+                     {"synthetic_res", job.synthetic_res},
+                     {"synthetic_seed", job.synthetic_seed},
+                     {"spp", o.spp},
+                     {"lr", o.lr},
+                     {"lr_min", o.lr_min},
+                     {"lr_period", o.lr_period},
+                     {"lr_t_mult", o.lr_t_mult},
+                     {"huber_delta", o.huber_delta},
+                     {"emission_decay", o.emission_decay},
+                     {"emitter_response_decay", o.emitter_response_decay},
+                     {"patience", o.patience},
+                     {"min_delta", o.min_delta},
+                     {"smoothing", o.smoothing},
+                     {"reuse_paths", o.reuse_paths}});
     return settings;
 }
 

@@ -97,20 +97,25 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
     return f;
 }
 
-nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, const FitState& state) {
-    const FitOptions& o = job.options;
+nlohmann::json fit_model_settings(const FitJob& job) {
     nlohmann::json m = {{"scene", fs::absolute(job.scene).string()},
                         {"defines", job.defines},
                         {"param", job.param},
                         {"gate", job.gate},
                         {"terms", job.terms},
-                        {"tone", to_string(o.tone)},
-                        {"latent_width", w},
-                        {"latent_height", h},
-                        {"seed", o.seed},
-                        {"vae_dir", default_vae_dir(job.vae.dir)},
+                        {"tone", to_string(job.options.tone)},
+                        {"seed", job.options.seed},
                         {"ref_tone", job.ref_tone}};
     if (job.sampler) m["sampler"] = sampler_name(*job.sampler);  // absent: the scene file's
+    return m;
+}
+
+nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, const FitState& state) {
+    const FitOptions& o = job.options;
+    nlohmann::json m = fit_model_settings(job);
+    m["latent_width"] = w;
+    m["latent_height"] = h;
+    m["vae_dir"] = default_vae_dir(job.vae.dir);
     if (job.vae.torchscript())
         m["vae_torchscript"] = {{"encoder", fs::absolute(job.vae.encoder).string()},
                                 {"decoder", fs::absolute(job.vae.decoder).string()},

@@ -58,7 +58,12 @@ std::vector<float> interleave_terms(const std::vector<float>& e, const std::vect
 /// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac").
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
 
-/// fit.json of a finished stage 1: everything load_fit_folder needs, plus how the stage went.
+/// What makes a fit's model what it is (scene, defines, parameterisation, terms, tone, seed,
+/// sampler): the keys fit.json and the stage-1 checkpoint's settings share.
+nlohmann::json fit_model_settings(const FitJob& job);
+
+/// fit.json of a finished stage 1: fit_model_settings, the latent size and VAE (everything
+/// load_fit_folder needs), plus how the stage went.
 nlohmann::json fit_manifest(const FitJob& job, int latent_width, int latent_height, double final_loss,
                             const lpt::FitState& state);
 
