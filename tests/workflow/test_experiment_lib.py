@@ -43,6 +43,13 @@ class Preset(unittest.TestCase):
         c = X.settings(paper=True, emission_decay=1e-4, emitter_response_decay=0)
         self.assertIn("--emission-decay 0.0001", X.fit_command(c, "cbox-specular", "ea", 2))
         self.assertNotIn("--emitter-response-decay", X.fit_command(c, "cbox-specular", "ea", 2))
+        # the parameterisation: named only when not code, never over the baseline's own classic
+        self.assertNotIn("--param", X.fit_command(X.settings(paper=True), "cbox-specular", "ea", 2))
+        gain = X.settings(param="gain")
+        self.assertIn("--param gain", X.fit_command(gain, "cbox-specular", "e", 2))
+        baseline = X.fit_command(gain, "cbox-specular", "baseline", 2)
+        self.assertIn("--param classic", baseline)
+        self.assertNotIn("--param gain", baseline)
         c = X.settings(paper=True, image_res=256, frame_step=2, fit_iterations=10)
         self.assertEqual(X.image_res_of(c, "cbox-specular"), 256)
         self.assertEqual((c["frame_step"], c["fit_iterations"]), (2, 10))
