@@ -33,6 +33,8 @@ int ParamStore::add(const std::string& name, const std::string& kind, ParamMap m
     if (find(name) >= 0) throw std::invalid_argument("duplicate parameter '" + name + "'");
     if (channels <= 0 || !(lo <= hi))
         throw std::invalid_argument("parameter '" + name + "': bad channel count or range");
+    if (map == ParamMap::Gain && !(lo <= 0.f && hi >= 0.f))  // a gain scales u; 0 must stay reachable
+        throw std::invalid_argument("parameter '" + name + "': a gain slice's range must contain 0");
     ParamSlice s;
     s.name = name;
     s.kind = kind;
@@ -70,9 +72,11 @@ void set_gain_value(const ParamSlice& s, const float* v, float* r) {
             throw std::invalid_argument("parameter '" + s.name + "': value outside its range");
     }
     const float g = std::log(need);
-    if (g > kGainHi) throw std::invalid_argument("parameter '" + s.name + "': value beyond the largest gain");
+    // slack of a few ulp: 6·e^12, which clamp_raw produces, must come back
+    if (g > kGainHi * (1.f + 1e-6f))
+        throw std::invalid_argument("parameter '" + s.name + "': value beyond the largest gain");
     for (int c = 0; c < s.channels; ++c) r[c] = std::clamp(v[c] / need, s.lo, s.hi);
-    r[s.channels] = g;
+    r[s.channels] = std::min(g, kGainHi);
 }
 
 }  // namespace
@@ -246,6 +250,9 @@ void ParamStore::load_json(const std::string& text, const std::string& file) {
             if (!std::isfinite(v))
                 throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) +
                                          "] is not finite");
+            if (s.map == ParamMap::Gain && k == size_t(s.channels) && (v < kGainLo || v > kGainHi))
+                throw std::runtime_error(file + ": parameter '" + name + "': log-gain " + std::to_string(v) +
+                                         " outside [" + std::to_string(kGainLo) + ", " + std::to_string(kGainHi) + "]");
             m_raw[s.raw_offset + k] = v;
         }
     }

@@ -58,8 +58,10 @@ std::vector<float> interleave_terms(const std::vector<float>& e, const std::vect
 /// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac").
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
 
-/// What makes a fit's model what it is (scene, defines, parameterisation, terms, tone, seed,
-/// sampler): the keys fit.json and the stage-1 checkpoint's settings share.
+/// What makes a fit's model what it is (scene, defines, parameterisation, gate, terms, tone,
+/// seed, reference tone, sampler): the keys fit.json and the stage-1 checkpoint's settings
+/// share. A key added here makes older checkpoints refuse to resume (fit_checkpoint.cpp's
+/// settings_added_later lists the exceptions).
 nlohmann::json fit_model_settings(const FitJob& job);
 
 /// fit.json of a finished stage 1: fit_model_settings, the latent size and VAE (everything

@@ -387,8 +387,9 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
         cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     if decay and c.get("emitter_response_decay", 0):
         cmd += ["--emitter-response-decay", repr(float(c["emitter_response_decay"]))]
-    # named only when not the default, and never over a fit's own (the baseline's classic)
-    if c.get("param", "code") != "code" and "--param" not in extra:
+    # named only when not the default, never over a fit's own (the baseline's classic), and not
+    # in the training-reference job's scratch fit (`decay` False), whose command stays as it was
+    if decay and c.get("param", "code") != "code" and "--param" not in extra:
         cmd += ["--param", c["param"]]
     for define in SCENES[scene][1]:
         cmd += ["-D", define]

@@ -204,8 +204,8 @@ void expect_penalty_gradient_matches_differences(const std::function<double(Para
                 };
                 const double fd = (penalty_at(keep + h) - penalty_at(keep - h)) / (2 * h);
                 penalty_at(keep);
-                // Quadratic in the values, values affine in raw (gain: exponential in g, whose
-                // central difference is off by ~h²/6 relatively): exact up to rounding.
+                // Quadratic in the values, values affine in raw: exact up to rounding; the gain's
+                // e^(2g) makes the central difference off by (2h)²/6 relatively, inside the margin.
                 EXPECT_NEAR(grad[r], fd, 1e-4 + 1e-3 * std::abs(fd)) << sl.name << " raw " << r - sl.raw_offset;
                 if (penalised(sl)) ++penalised_entries;
                 else EXPECT_EQ(grad[r], 0.f) << sl.name;
@@ -320,8 +320,7 @@ TEST(Fit, GainReachesALightFarBeyondTheCodeClamp) {
     };
     const auto [code_loss, code_ratio] = fit(Parameterisation::Code);
     const auto [gain_loss, gain_ratio] = fit(Parameterisation::Gain);
-    EXPECT_LE(code_ratio, 6.f / bright[0] + 1e-6f);  // held inside the clamp
-    EXPECT_GT(gain_ratio, 6.f / bright[0]);          // grown past it
-    EXPECT_LT(gain_loss, 1.2 * floor);               // recovered: at the noise floor
-    EXPECT_GT(code_loss, 2.0 * floor);               // cannot get there
+    EXPECT_GT(gain_ratio, 6.f / bright[0]);  // grown past what the clamp lets code reach (code_ratio)
+    EXPECT_LT(gain_loss, 1.2 * floor);       // recovered: at the noise floor
+    EXPECT_GT(code_loss, 2.0 * floor);       // cannot get there
 }

@@ -115,12 +115,13 @@ def json_scene():
     return json.dumps(s, indent=1)
 
 
-def fit_state(binary):
+def fit_state(binary, param="code"):
     with tempfile.TemporaryDirectory() as tmp:
         out = pathlib.Path(tmp) / "fit"
         subprocess.run([binary, "fit", str(SRC / "scenes/cornell-box/scene.json"), "--out", str(out),
                         "--synthetic-res", "4x4", "--iterations", "3", "--spp", "1", "--final-spp", "1",
-                        "--no-refiner", "--checkpoint-every", "2", "--reuse-paths", "0", "-q"], check=True)
+                        "--no-refiner", "--checkpoint-every", "2", "--reuse-paths", "0", "--param", param, "-q"],
+                       check=True)
         fit = json.loads((out / "fit.json").read_text())
         fit["scene"] = "@DIR@/scene.json"
         state = json.loads((out / "checkpoint/state.json").read_text())
@@ -167,6 +168,7 @@ def main():
                     "emitter": {"type": "area", "radiance": [1, 1, 1]}}]}, indent=1))
     put("scene_xml", "features.xml", xml_scene())
     put("fit_state", "cornell_box", fit_state(a.bin))
+    put("fit_state", "cornell_box_gain", fit_state(a.bin, "gain"))  # a log-gain entry per Le slice
 
 
 if __name__ == "__main__":

@@ -68,6 +68,20 @@ TEST(ParamStore, SetValueRoundTripsThroughEveryMap) {
     EXPECT_NEAR(ps.raw()[ps.slice(3).raw_offset + 4], std::log(300.f / 6.f), 1e-5f);
     const float beyond[4] = {6.f * std::exp(kGainHi + 1.f), 0.f, 0.f, 0.f};
     EXPECT_THROW(ps.set_value(3, beyond), std::invalid_argument);
+    // the largest value the map makes comes back
+    const float largest[4] = {6.f * std::exp(kGainHi), 0.f, 0.f, 0.f};
+    ps.set_value(3, largest);
+    EXPECT_FLOAT_EQ(ps.value(3)[0], largest[0]);
+}
+
+TEST(ParamStore, GainReachesBothSignsOfAnAsymmetricRange) {
+    ParamStore ps;
+    ps.add("a.Le", "Le", ParamMap::Gain, 3, -2.f, 6.f);
+    const float v[3] = {-40.f, 100.f, 0.f};  // -40 needs e^g >= 20, 100 only 16.7
+    ps.set_value(0, v);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(ps.value(0)[c], v[c], 1e-4f);
+    EXPECT_NEAR(ps.raw()[3], std::log(20.f), 1e-5f);
+    EXPECT_THROW(ps.add("b.Le", "Le", ParamMap::Gain, 3, 0.5f, 6.f), std::invalid_argument);  // 0 out of reach
 }
 
 TEST(ParamStore, ClampKeepsRawInRange) {
@@ -88,6 +102,9 @@ TEST(ParamStore, GainStartsAtOneSoItsFirstValuesAreIdentitys) {
     identity.init_uniform("Le", -0.1f, 0.1f, 9);
     EXPECT_EQ(gain.values(), identity.values());
     EXPECT_EQ(gain.raw().back(), 0.f);
+    gain.raw().back() = 3.f;  // a fresh initialisation starts the gain again
+    gain.init_uniform("Le", -0.1f, 0.1f, 9);
+    EXPECT_EQ(gain.values(), identity.values());
 }
 
 TEST(ParamStore, JsonRoundTripIsExact) {
@@ -115,5 +132,6 @@ TEST(ParamStore, JsonErrorsNameFileAndParameter) {
     expect_error(R"({"slices": [{"name": "a.La", "raw": [0,0]}]})", "a.La");
     expect_error(R"({"slices": [{"name": "a.La", "map": "sigmoid", "raw": [0,0,0,0]}]})", "sigmoid");
     expect_error(R"({"slices": [)", "malformed");
+    expect_error(R"({"slices": [{"name": "a.Le", "raw": [0,0,0,0,1e4]}]})", "log-gain");  // e^1e4 overflows
     EXPECT_THROW(ps.add("a.La", "La", ParamMap::Identity, 4, -6.f, 6.f), std::invalid_argument);
 }

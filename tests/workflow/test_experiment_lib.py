@@ -61,6 +61,7 @@ class Preset(unittest.TestCase):
             self.assertIn(part, cmd)
         self.assertNotIn("$(", cmd)
         self.assertNotIn("--emission-decay", cmd)  # its command, and so its cached job, stay as they were
+        self.assertEqual(cmd, X.training_reference_command(X.settings(paper=True, param="gain"), "cbox-specular", 2))
 
 
 class Table1(unittest.TestCase):
