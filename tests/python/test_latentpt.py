@@ -110,6 +110,10 @@ class LatentTest(unittest.TestCase):
         np.testing.assert_allclose(m.value("light.Le"), np.exp(0.5) * raw[le["raw_offset"]:le["raw_offset"] + 16],
                                    rtol=1e-6)
         self.check_adjoint(m, {"light.Le": (0, 5, 16), "floor.La": (0,)})
+        raw[le["raw_offset"] + 16] = 50.0  # e^50 overflows float: refused, the model untouched
+        with self.assertRaisesRegex(ValueError, "light.Le"):
+            m.raw = raw
+        self.assertAlmostEqual(float(m.raw[le["raw_offset"] + 16]), 0.5, places=6)
 
     def test_torch_function_backward_is_the_adjoint(self):
         torch = torch_or_skip()
