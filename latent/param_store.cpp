@@ -29,6 +29,12 @@ ParamMap param_map_from_string(const std::string& s) {
     throw std::invalid_argument("unknown parameter map '" + s + "' (known: identity, sigmoid, posneg, gain)");
 }
 
+std::string ParamSlice::raw_problem(size_t k, float v) const {
+    if (map != ParamMap::Gain || k != size_t(channels) || (v >= kGainLo && v <= kGainHi)) return "";
+    return "log-gain " + std::to_string(v) + " outside [" + std::to_string(kGainLo) + ", " + std::to_string(kGainHi) +
+           "]";
+}
+
 int ParamStore::add(const std::string& name, const std::string& kind, ParamMap map, int channels, float lo, float hi) {
     if (find(name) >= 0) throw std::invalid_argument("duplicate parameter '" + name + "'");
     if (channels <= 0 || !(lo <= hi))
@@ -181,8 +187,7 @@ void ParamStore::clamp_raw() {
     for (const ParamSlice& s : m_slices) {
         if (s.map == ParamMap::Sigmoid) continue;  // unbounded raw by design
         float* r = m_raw.data() + s.raw_offset;
-        const size_t vector_size = s.map == ParamMap::Gain ? size_t(s.channels) : s.raw_size();
-        for (size_t k = 0; k < vector_size; ++k) r[k] = std::clamp(r[k], s.lo, s.hi);
+        for (size_t k = 0; k < s.vector_raw_size(); ++k) r[k] = std::clamp(r[k], s.lo, s.hi);
         if (s.map == ParamMap::Gain) r[s.channels] = std::clamp(r[s.channels], kGainLo, kGainHi);
     }
     update_values();
@@ -192,8 +197,7 @@ void ParamStore::init_uniform(const std::string& kind, float a, float b, uint64_
     for (size_t i = 0; i < m_slices.size(); ++i) {
         const ParamSlice& s = m_slices[i];
         if (s.kind != kind) continue;
-        const size_t vector_size = s.map == ParamMap::Gain ? size_t(s.channels) : s.raw_size();
-        for (size_t k = 0; k < vector_size; ++k)
+        for (size_t k = 0; k < s.vector_raw_size(); ++k)
             m_raw[s.raw_offset + k] = a + (b - a) * sample_1d(seed, uint32_t(i), uint32_t(k), 0);
         if (s.map == ParamMap::Gain) m_raw[s.raw_offset + s.channels] = 0.f;
     }
@@ -250,9 +254,8 @@ void ParamStore::load_json(const std::string& text, const std::string& file) {
             if (!std::isfinite(v))
                 throw std::runtime_error(file + ": parameter '" + name + "': raw[" + std::to_string(k) +
                                          "] is not finite");
-            if (s.map == ParamMap::Gain && k == size_t(s.channels) && (v < kGainLo || v > kGainHi))
-                throw std::runtime_error(file + ": parameter '" + name + "': log-gain " + std::to_string(v) +
-                                         " outside [" + std::to_string(kGainLo) + ", " + std::to_string(kGainHi) + "]");
+            const std::string problem = s.raw_problem(k, v);
+            if (!problem.empty()) throw std::runtime_error(file + ": parameter '" + name + "': " + problem);
             m_raw[s.raw_offset + k] = v;
         }
     }

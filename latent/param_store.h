@@ -35,6 +35,11 @@ struct ParamSlice {
     size_t raw_size() const {
         return map == ParamMap::PosNeg ? 2 * size_t(channels) : size_t(channels) + (map == ParamMap::Gain ? 1 : 0);
     }
+    /// Raw entries of the vector itself: all but a Gain slice's trailing log-gain.
+    size_t vector_raw_size() const { return map == ParamMap::Gain ? size_t(channels) : raw_size(); }
+    /// Why raw entry k cannot hold v, or "" if it can: a Gain slice's log-gain must lie in
+    /// [kGainLo, kGainHi] (e^g of a larger one overflows); the other entries take any value.
+    std::string raw_problem(size_t k, float v) const;
 };
 
 class ParamStore {

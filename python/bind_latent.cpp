@@ -120,13 +120,13 @@ py::array_t<float> tone_backward(const LatentScene& ls,
 void set_raw(LatentScene& ls, const py::array_t<float, py::array::c_style | py::array::forcecast>& raw) {
     ParamStore& ps = ls.model->params();
     std::vector<float> r = from_numpy(raw, ps.raw().size(), "raw");
-    // A log-gain past its range would overflow e^g (docs/params.md (4)); params.json refuses it too.
+    // What params.json refuses too (a log-gain that would overflow e^g, docs/params.md (4)).
     for (size_t i = 0; i < ps.slice_count(); ++i) {
         const ParamSlice& s = ps.slice(int(i));
-        const float g = s.map == ParamMap::Gain ? r[s.raw_offset + size_t(s.channels)] : 0.f;
-        if (!(g >= kGainLo && g <= kGainHi))
-            throw py::value_error("raw: " + s.name + "'s log-gain " + std::to_string(g) + " is outside [" +
-                                  std::to_string(kGainLo) + ", " + std::to_string(kGainHi) + "]");
+        for (size_t k = 0; k < s.raw_size(); ++k) {
+            const std::string problem = s.raw_problem(k, r[s.raw_offset + k]);
+            if (!problem.empty()) throw py::value_error("raw: " + s.name + ": " + problem);
+        }
     }
     ps.raw() = std::move(r);
     ls.model->sync();
