@@ -39,6 +39,17 @@ FitOptions fit_options(int iterations) {
     return o;
 }
 
+/// Huber loss against `target` of 4-spp renders of `m` with seeds first_seed … first_seed + 7,
+/// averaged: the fit's own sample count, so a perfect fit scores the noise floor.
+double loss_at_4spp(const LatentModel& m, const Scene& scene, const std::vector<float>& target, uint64_t first_seed) {
+    double loss = 0;
+    for (uint64_t s = 0; s < 8; ++s) {
+        auto img = render_toned(m, target_options(scene, 4, first_seed + s), ToneCurve::Clip);
+        loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
+    }
+    return loss;
+}
+
 }  // namespace
 
 TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
@@ -47,11 +58,7 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
     LatentModel truth(target_scene, Parameterisation::Code, 1);
     const std::vector<float> target = render_toned(truth, target_options(target_scene, 256, 99), ToneCurve::Clip);
     // Noise floor: the true parameters rendered with the fit's spp against the target.
-    double floor = 0;
-    for (uint64_t s = 0; s < 8; ++s) {
-        auto img = render_toned(truth, target_options(target_scene, 4, 1000 + s), ToneCurve::Clip);
-        floor += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
-    }
+    double floor = loss_at_4spp(truth, target_scene, target, 1000);
     auto run = [&](bool extra_terms, int reuse_paths) {
         Scene scene = cornell();
         LatentModel m(scene, Parameterisation::Code, 2);
@@ -61,11 +68,7 @@ TEST(Fit, RecoversSelfRenderedTargetAndExtraTermsDoNotHurt) {
         FitOptions fo = fit_options(400);
         fo.reuse_paths = reuse_paths;
         FitState st = fit_latent(m, target, kRes, kRes, fo);
-        double final_loss = 0;
-        for (uint64_t s = 0; s < 8; ++s) {
-            auto img = render_toned(m, target_options(scene, 4, 2000 + s), ToneCurve::Clip);
-            final_loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
-        }
+        double final_loss = loss_at_4spp(m, scene, target, 2000);
         std::cout << (extra_terms ? "Ie+Ia+Ic" : "Ie only") << " (reuse " << reuse_paths << "): initial " << initial
                   << ", final " << final_loss << ", noise floor " << floor << ", skipped steps " << st.skipped_steps
                   << "\n";
@@ -258,10 +261,7 @@ DecayedFit fit_with_decay(float emission_decay, float emitter_response_decay) {
             if (ps.slice(int(k)).kind == "Le") r.le2 += v2;
             if (ps.slice(int(k)).name == "light.La" || ps.slice(int(k)).name == "light.Lc") r.light_responses2 += v2;
         }
-    for (uint64_t s = 0; s < 8; ++s) {
-        auto img = render_toned(m, target_options(scene, 4, 3000 + s), ToneCurve::Clip);
-        r.loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
-    }
+    r.loss = loss_at_4spp(m, scene, target, 3000);
     std::cout << "decays " << emission_decay << ", " << emitter_response_decay << ": sum Le^2 " << r.le2
               << ", light La^2 + Lc^2 " << r.light_responses2 << ", loss " << r.loss << "\n";
     return r;
@@ -298,21 +298,13 @@ TEST(Fit, GainReachesALightFarBeyondTheCodeClamp) {
     truth.sync();
     truth.terms().ambient = truth.terms().occlusion = false;  // only L̃e can make the room bright
     const std::vector<float> target = render_toned(truth, target_options(ts, 256, 99), ToneCurve::Clip);
-    double floor = 0;  // the truth itself at the fit's 4 spp
-    for (uint64_t s = 0; s < 8; ++s) {
-        auto img = render_toned(truth, target_options(ts, 4, 4000 + s), ToneCurve::Clip);
-        floor += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
-    }
+    double floor = loss_at_4spp(truth, ts, target, 4000);
     auto fit = [&](Parameterisation p) {
         Scene scene = cornell();
         LatentModel m(scene, p, 2);
         m.terms().ambient = m.terms().occlusion = false;
         fit_latent(m, target, kRes, kRes, fit_options(300));
-        double loss = 0;
-        for (uint64_t s = 0; s < 8; ++s) {
-            auto img = render_toned(m, target_options(scene, 4, 4000 + s), ToneCurve::Clip);
-            loss += huber_loss(img.data(), target.data(), target.size(), 1.f, nullptr) / 8;
-        }
+        double loss = loss_at_4spp(m, scene, target, 4000);
         const float gain = m.params().value(le)[0] / bright[0];
         std::cout << (p == Parameterisation::Gain ? "gain" : "code") << ": loss " << loss << " (floor " << floor
                   << "), light channel 0 at " << gain << " of the truth's\n";
