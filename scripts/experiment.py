@@ -38,6 +38,7 @@ import argparse
 import fcntl
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -64,6 +65,36 @@ def snakemake_command(a, config_path, out):
     if a.redo:
         cmd += ["--forceall"]
     return cmd + a.snakemake_args
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def run_workflow(cmd):
+    """Run Snakemake in a process group of its own and return (its exit status, the stop signal
+    received or None). A SIGINT, SIGTERM or SIGHUP to this process reaches the whole group as the
+    SIGINT of a terminal's Ctrl-C: running jobs stop where they are (killed jobs resume on the next
+    run) and Snakemake cancels its Slurm jobs. Snakemake alone would finish its running jobs first,
+    and a parent that exits at once (Python's SIGTERM) would free the folder's lock with Snakemake
+    still running, so this process waits for the group with the lock held. A second signal kills
+    the group."""
+    p = subprocess.Popen(cmd, start_new_session=True)
+    received = []
+
+    def forward(signum, _frame):
+        received.append(signum)
+        try:
+            os.killpg(p.pid, signal.SIGINT if len(received) == 1 else signal.SIGKILL)
+        except ProcessLookupError:  # the group has already gone
+            pass
+
+    before = {s: signal.signal(s, forward) for s in STOP_SIGNALS}
+    try:
+        returncode = p.wait()
+    finally:
+        for s, handler in before.items():
+            signal.signal(s, handler)
+    return returncode, (received[0] if received else None)
 
 
 def main():
@@ -121,9 +152,13 @@ def main():
     config_path = os.path.join(c["out"], "experiment-config.json")
     X.write_atomic(config_path, json.dumps(c, indent=1))
     started = time.time()
-    r = subprocess.run(snakemake_command(a, config_path, c["out"]))
-    if r.returncode != 0:
-        sys.exit(f"experiment: the workflow failed (exit {r.returncode}); job logs in {c['out']}/<scene>/logs; "
+    returncode, stopped_by = run_workflow(snakemake_command(a, config_path, c["out"]))
+    if stopped_by is not None:
+        print(f"experiment: stopped by {signal.Signals(stopped_by).name}; finished jobs are kept in {c['out']}: "
+              "run again with the same flags to continue", file=sys.stderr)
+        return 128 + stopped_by
+    if returncode != 0:
+        sys.exit(f"experiment: the workflow failed (exit {returncode}); job logs in {c['out']}/<scene>/logs; "
                  "run again with the same flags to continue")
     if "--dry-run" in a.snakemake_args or "-n" in a.snakemake_args:
         return 0
