@@ -19,6 +19,14 @@ The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ
 
     python3 scripts/reference_noise.py --scene-dir results-paper/cbox-specular --seed-dir noise_seed1
 
+    python3 scripts/reference_noise.py --scene-dir results-paper/veach-bidir --seed-dir noise_seed1 \
+        --size 512 --ablation
+
+--ablation scores Table 1's four columns (the e and ea fits' frames, the eac fit's rendered and
+refined frames) and writes the experiment's Table 1 twice: against r₁, as the experiment scores
+(its cells up to the PNGs' rounding), and against the cleaner references, with the targets'
+misses under each.
+
 <scene-dir>/<seed-dir>/<sequence>/ are `render <scene-dir>/fit_eac --edit edits-<sequence>.json
 --reference --ref-seed S --reference-cache <scene-dir>/refs` outputs for the same frames as the
 experiment; their references sit in refs/ beside the experiment's, named with `_seed<S>`.
@@ -62,8 +70,28 @@ def frame_row(m, x_png, r1, r2, rbar, r12):
     }
 
 
+# The decoded frame each column of a table scores: (edit folder of a sequence, file of frame f).
+TWO_COLUMNS = {"rendered": (None, "frame_{f:04d}_rendered.png"), "refined": (None, "frame_{f:04d}.png")}
+ABLATION_COLUMNS = {  # Table 1's, keyed as experiment_lib.TABLE1_COLUMNS
+    "e": ("{seq}_e", "frame_{f:04d}.png"), "ea": ("{seq}_ea", "frame_{f:04d}.png"),
+    "eac": ("{seq}_eac", "frame_{f:04d}_rendered.png"), "eac+refiner": ("{seq}_eac", "frame_{f:04d}.png")}
+
+
 def mean(rows, key):
     return sum(r[key] for r in rows) / len(rows)
+
+
+def columns_of(a, scene_dir, seq):
+    """{column: (folder, frame file pattern)} of one sequence; a column whose folder is missing is
+    left out (an experiment folder need not keep every fit's frames)."""
+    if not a.ablation:
+        return {k: (os.path.join(scene_dir, a.folder.format(seq=seq)), png) for k, (_, png) in TWO_COLUMNS.items()}
+    cols = {k: (os.path.join(scene_dir, folder.format(seq=seq)), png) for k, (folder, png) in ABLATION_COLUMNS.items()}
+    for k, (folder, _) in list(cols.items()):
+        if not os.path.isdir(folder):
+            print(f"reference_noise: {folder} missing: column {k} left out of {seq}", file=sys.stderr)
+            del cols[k]
+    return cols
 
 
 def main():
@@ -73,6 +101,9 @@ def main():
     p.add_argument("--seed", type=int, default=1, help="the second references' --ref-seed")
     p.add_argument("--folder", default="{seq}_eac",
                    help="edit folder (in --scene-dir) of each sequence holding the decoded frames; {seq} = its name")
+    p.add_argument("--ablation", action="store_true",
+                   help="score Table 1's four columns ({seq}_e, {seq}_ea, {seq}_eac rendered and refined) instead "
+                        "of --folder's rendered and refined frames, and write Table 1 against the cleaner references")
     p.add_argument("--report", default="reference_noise", help="report name (.md and .json in the seed dir)")
     p.add_argument("--sequences", default="camera,object,light")
     p.add_argument("--frames", default="0,15,30,45")
@@ -101,44 +132,82 @@ def main():
 
         for seq in a.sequences.split(","):
             rows = []
+            columns = columns_of(a, a.scene_dir, seq)
             for f in frames:
                 s1, r1, r2, rbar, r12 = refs_of(seq, f)
-                folder = os.path.join(a.scene_dir, a.folder.format(seq=seq))
                 row = {"frame": f, "sigma2_x100": 0.5 * r12}
-                for kind, png in (("refined", f"frame_{f:04d}.png"), ("rendered", f"frame_{f:04d}_rendered.png")):
-                    row[kind] = frame_row(m, os.path.join(folder, png), r1, r2, rbar, r12)
+                for kind, (folder, png) in columns.items():
+                    row[kind] = frame_row(m, os.path.join(folder, png.format(f=f)), r1, r2, rbar, r12)
                 rows.append(row)
                 print(seq, f, json.dumps(row), flush=True)
             result["sequences"][seq] = rows
-        # The VAE round trip of the training view: dec(enc(r₁)) against r₂ less σ² is its
-        # distance from the converged view; against r₁ it is what the table calls the floor.
-        s1, r1, r2, rbar, r12 = refs_of("training", 0)
-        rt = os.path.join(tmp, "roundtrip.png")
-        subprocess.run([a.bin, "decode", s1 + "_latent.exr", "-o", rt, "-q"], check=True)
-        f1, f2 = m(rt, r1), m(rt, r2)
-        result["floor"] = {"mse_r1": f1["mse_x100"], "mse_r2_corrected": f2["mse_x100"] - 0.5 * r12,
-                           "lpips_r1": f1["lpips"], "lpips_r2": f2["lpips"], "sigma2_x100": 0.5 * r12}
+        result["floor"] = round_trip_floor(a, m, refs_of, tmp)
     write_report(out, a, result)
 
 
+def round_trip_floor(a, m, refs_of, tmp):
+    """The VAE round trip of the training view: dec(enc(r₁)) against r₂ less σ² is its distance
+    from the converged view; against r₁ it is what the table calls the floor. LPIPS has no
+    correction: dec(enc(r̄)) against r̄ is the round trip at twice the spp, the floor of the
+    LPIPS-against-r̄ columns."""
+    s1, r1, r2, rbar, r12 = refs_of("training", 0)
+    rt, rt_mean, latent_mean = (os.path.join(tmp, n) for n in ("roundtrip.png", "roundtrip_mean.png", "mean.exr"))
+    subprocess.run([a.bin, "decode", s1 + "_latent.exr", "-o", rt, "-q"], check=True)
+    subprocess.run([a.bin, "encode", rbar, "-o", latent_mean, "-q"], check=True)
+    subprocess.run([a.bin, "decode", latent_mean, "-o", rt_mean, "-q"], check=True)
+    f1, f2, fm = m(rt, r1), m(rt, r2), m(rt_mean, rbar)
+    return {"mse_r1": f1["mse_x100"], "mse_r2_corrected": f2["mse_x100"] - 0.5 * r12,
+            "lpips_r1": f1["lpips"], "lpips_r2": f2["lpips"], "lpips_mean_ref_roundtrip": fm["lpips"],
+            "sigma2_x100": 0.5 * r12}
+
+
+def table1_lines(a, result, measure):
+    """experiment_lib's Table 1 of these frames: LPIPS and MSE×100 against r₁ (the experiment's
+    protocol: reproduces its cells up to the PNGs' rounding), or against the cleaner references
+    (LPIPS against r̄, noise-corrected MSE; floor: the round trip at r̄, noise-corrected)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import experiment_lib as X
+    scene = os.path.basename(os.path.normpath(a.scene_dir))
+    if scene not in X.PAPER_TABLE1 or set(result["sequences"]) != set(X.KINDS):
+        return [], []
+    lpips_key, mse_key = ("lpips_r1", "mse_r1") if measure == "r1" else ("lpips_mean_ref", "mse_corrected")
+    fl = result["floor"]
+    floor = ((fl["lpips_r1"], fl["mse_r1"]) if measure == "r1"
+             else (fl["lpips_mean_ref_roundtrip"], fl["mse_r2_corrected"]))
+    edits = {seq: {k: {"rgb_lpips": mean([r[k] for r in rows], lpips_key), "rgb_mse_x100": mean([r[k] for r in rows], mse_key)}
+                   for k in rows[0] if k not in ("frame", "sigma2_x100")}
+             for seq, rows in result["sequences"].items()}
+    summary = {scene: {"training_view": {"vae_roundtrip": {"rgb_lpips": floor[0], "rgb_mse_x100": floor[1]}},
+                       "edits": edits}}
+    return X.table1({"scene_res": {scene: a.size}, "image_res": a.size}, summary)
+
+
 def write_report(out, a, result):
-    lines = [f"# Reference noise on {a.scene_dir}/{a.folder} ({a.ref_spp}-spp references, seeds 0x5eed and {a.seed})",
+    lines = [f"# Reference noise on {a.scene_dir} ({a.ref_spp}-spp references, seeds 0x5eed and {a.seed})",
              "",
              "Mean over frames " + a.frames + ". MSE×100: against the experiment's reference r₁ (the table's), "
              "noise-corrected (an estimate against the converged view), and the references' own variance σ²×100. "
-             "LPIPS against r₁ and against the mean of both references (twice the spp).", "",
-             "| sequence | column | MSE×100 vs r₁ | MSE×100 corrected | σ²×100 | LPIPS vs r₁ | LPIPS vs mean |",
+             "LPIPS against r₁ and against the mean of both references r̄ (twice the spp).", "",
+             "| sequence | column | MSE×100 vs r₁ | MSE×100 corrected | σ²×100 | LPIPS vs r₁ | LPIPS vs r̄ |",
              "|---|---|---|---|---|---|---|"]
     for seq, rows in result["sequences"].items():
         s2 = mean(rows, "sigma2_x100")
-        for kind in ("rendered", "refined"):
+        for kind in (k for k in rows[0] if k not in ("frame", "sigma2_x100")):
             k = [r[kind] for r in rows]
             lines.append(f"| {seq} | {kind} | {mean(k, 'mse_r1'):.4f} | {mean(k, 'mse_corrected'):.4f} | {s2:.4f} | "
                          f"{mean(k, 'lpips_r1'):.4f} | {mean(k, 'lpips_mean_ref'):.4f} |")
     fl = result["floor"]
     lines += ["", f"VAE round trip of the training view: MSE×100 {fl['mse_r1']:.4f} against r₁, "
               f"{fl['mse_r2_corrected']:.4f} noise-corrected; LPIPS {fl['lpips_r1']:.4f} against r₁, "
-              f"{fl['lpips_r2']:.4f} against r₂; σ²×100 {fl['sigma2_x100']:.4f}.", ""]
+              f"{fl['lpips_r2']:.4f} against r₂, {fl['lpips_mean_ref_roundtrip']:.4f} for r̄'s own round trip; "
+              f"σ²×100 {fl['sigma2_x100']:.4f}.", ""]
+    if a.ablation:
+        for measure, title in (("r1", "against r₁ (the experiment's protocol)"),
+                               ("clean", "against the cleaner references (LPIPS vs r̄, MSE×100 noise-corrected)")):
+            md, misses = table1_lines(a, result, measure)
+            if md:
+                lines += [f"## Table 1 {title}: {len(misses)} target misses", ""] + md + [""]
+                lines += [f"- {x}" for x in misses] + [""]
     for name, text in ((a.report + ".json", json.dumps(result, indent=1)), (a.report + ".md", "\n".join(lines))):
         tmp = os.path.join(out, name + ".tmp")
         with open(tmp, "w") as fh:

@@ -90,6 +90,22 @@ class Table1(unittest.TestCase):
         self.assertEqual(sorted(m.split(" ")[0] for m in misses if "1.5× the round trip" in m),
                          ["cbox-specular/light", "cbox-specular/object"])
 
+    def test_a_missing_column_is_a_dash_and_skipped_by_the_ordering(self):
+        c = X.settings(paper=True, scenes=["cbox-specular"])
+        good = [(0.5, 2.0), (0.2, 0.3), (0.15, 0.2), (0.01, 0.02)]
+        summary = self.summary(good, (0.005, 0.01))
+        for kind in X.KINDS:
+            summary["cbox-specular"]["edits"][kind] = {k: v for k, v in summary["cbox-specular"]["edits"][kind].items()
+                                                       if k not in ("e", "eac")}
+        md, misses = X.table1(c, summary)
+        self.assertEqual(misses, [])
+        self.assertTrue(md[2].split(" | ")[2].startswith("– (0.502"), md[2])
+        # +refiner is then compared with +Ĩa, the nearest column before it that is there
+        for kind in X.KINDS:
+            summary["cbox-specular"]["edits"][kind]["eac+refiner"] = {"rgb_lpips": 0.25, "rgb_mse_x100": 0.02}
+        _, misses = X.table1(c, summary)
+        self.assertEqual(sum("LPIPS: +refiner 0.250 not below +Ĩa 0.200" in m for m in misses), 3)
+
 
 if __name__ == "__main__":
     unittest.main()
