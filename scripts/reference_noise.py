@@ -81,15 +81,20 @@ def mean(rows, key):
     return sum(r[key] for r in rows) / len(rows)
 
 
-def columns_of(a, scene_dir, seq):
-    """{column: (folder, frame file pattern)} of one sequence; a column whose folder is missing is
-    left out (an experiment folder need not keep every fit's frames)."""
+def columns_of(a, scene_dir, seq, frames):
+    """{column: (folder, frame file pattern)} of one sequence. With --ablation a column lacking a
+    frame is left out (an experiment folder need not keep every fit's frames); else a missing
+    frame is an error, found before any metric is computed."""
     if not a.ablation:
-        return {k: (os.path.join(scene_dir, a.folder.format(seq=seq)), png) for k, (_, png) in TWO_COLUMNS.items()}
-    cols = {k: (os.path.join(scene_dir, folder.format(seq=seq)), png) for k, (folder, png) in ABLATION_COLUMNS.items()}
-    for k, (folder, _) in list(cols.items()):
-        if not os.path.isdir(folder):
-            print(f"reference_noise: {folder} missing: column {k} left out of {seq}", file=sys.stderr)
+        cols = {k: (os.path.join(scene_dir, a.folder.format(seq=seq)), png) for k, (_, png) in TWO_COLUMNS.items()}
+    else:
+        cols = {k: (os.path.join(scene_dir, folder.format(seq=seq)), png) for k, (folder, png) in ABLATION_COLUMNS.items()}
+    for k, (folder, png) in list(cols.items()):
+        missing = [os.path.join(folder, png.format(f=f)) for f in frames if not os.path.exists(os.path.join(folder, png.format(f=f)))]
+        if missing and not a.ablation:
+            sys.exit(f"reference_noise: {missing[0]} missing")
+        if missing:
+            print(f"reference_noise: {missing[0]} missing: column {k} left out of {seq}", file=sys.stderr)
             del cols[k]
     return cols
 
@@ -124,15 +129,18 @@ def main():
             s2 = reference_stem(refs, seq, a.size, a.ref_spp, f, f"_seed{a.seed}")
             r1, r2, rbar = (os.path.join(tmp, f"{seq}_{f}_{k}.png") for k in ("r1", "r2", "mean"))
             for exr, png in ((s1 + ".exr", r1), (s2 + ".exr", r2)):
-                if not os.path.exists(exr):
-                    sys.exit(f"{exr}: missing (run render --edit --reference --ref-seed {a.seed} first)")
                 display_png(exr, png)
             mean_png(r1, r2, rbar)
             return s1, r1, r2, rbar, m(r1, r2)["mse_x100"]
 
-        for seq in a.sequences.split(","):
+        columns_by_seq = {seq: columns_of(a, a.scene_dir, seq, frames) for seq in a.sequences.split(",")}
+        for seq, f in [(seq, f) for seq in columns_by_seq for f in frames] + [("training", 0)]:
+            for suffix in ("", f"_seed{a.seed}"):
+                exr = reference_stem(refs, seq, a.size, a.ref_spp, f, suffix) + ".exr"
+                if not os.path.exists(exr):
+                    sys.exit(f"{exr}: missing (run render --edit --reference --ref-seed {a.seed} first)")
+        for seq, columns in columns_by_seq.items():
             rows = []
-            columns = columns_of(a, a.scene_dir, seq)
             for f in frames:
                 s1, r1, r2, rbar, r12 = refs_of(seq, f)
                 row = {"frame": f, "sigma2_x100": 0.5 * r12}
