@@ -78,18 +78,26 @@ def run_workflow(cmd):
     and a parent that exits at once (Python's SIGTERM) would free the folder's lock with Snakemake
     still running, so this process waits for the group with the lock held. A second signal kills
     the group."""
-    p = subprocess.Popen(cmd, start_new_session=True)
-    received = []
+    received, group = [], []
 
     def forward(signum, _frame):
         received.append(signum)
+        stop(signal.SIGINT if len(received) == 1 else signal.SIGKILL)
+
+    def stop(sig):
         try:
-            os.killpg(p.pid, signal.SIGINT if len(received) == 1 else signal.SIGKILL)
+            if group:
+                os.killpg(group[0], sig)
         except ProcessLookupError:  # the group has already gone
             pass
 
+    # Handlers first: a signal that comes while Snakemake starts must not end this process alone.
     before = {s: signal.signal(s, forward) for s in STOP_SIGNALS}
     try:
+        p = subprocess.Popen(cmd, start_new_session=True)
+        group.append(p.pid)
+        if received:  # arrived before the group existed
+            stop(signal.SIGINT)
         returncode = p.wait()
     finally:
         for s, handler in before.items():

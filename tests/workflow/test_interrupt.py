@@ -3,7 +3,7 @@
 `timeout`) stops the whole run before experiment.py exits: no job or Snakemake process of it
 is left running beside a run started next, and the folder's lock is free. experiment.py exits
 with 128 + the signal and says how to continue. The latentpt jobs are a stand-in script that
-records its pid and sleeps, so the test costs no CPU (~10 s).
+records its pid and sleeps, so the test costs no CPU (~5 s).
 
     tests/workflow/test_interrupt.py
 Exit 77 (skipped) without snakemake or ../shared."""
