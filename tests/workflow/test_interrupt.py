@@ -32,12 +32,20 @@ def alive(pid):
         return False
 
 
-def group_alive(pgid):
-    try:
-        os.killpg(pgid, 0)
-        return True
-    except ProcessLookupError:
-        return False
+def group_members(pgid):
+    """Running (not zombie) processes of process group pgid. kill(-pgid, 0) would count a
+    zombie that init has not reaped yet."""
+    members = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    fields = f.read().rsplit(")", 1)[1].split()
+            except (FileNotFoundError, ProcessLookupError):
+                continue
+            if fields[0] != "Z" and int(fields[2]) == pgid:
+                members.append(int(entry))
+    return members
 
 
 def wait_until(condition, seconds):
@@ -80,7 +88,9 @@ def stop_mid_job(tmp, binary, sig):
             p.wait(timeout=60)
         except subprocess.TimeoutExpired:
             raise AssertionError(f"{name}: experiment.py still running 60 s after the signal")
-        left = [j for j in jobs if alive(j)] + [f"group {g}" for g in groups if group_alive(g)]
+        # Processes of the group that Snakemake did not wait for may take a moment to go.
+        wait_until(lambda: not any(alive(j) for j in jobs) and not any(group_members(g) for g in groups), 10)
+        left = [j for j in jobs if alive(j)] + [f"group {g}: {group_members(g)}" for g in groups if group_members(g)]
     finally:
         for g in groups:  # leave nothing behind when a check fails
             try:
