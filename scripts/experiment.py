@@ -95,8 +95,8 @@ def run_workflow(cmd):
     before = {s: signal.signal(s, forward) for s in STOP_SIGNALS}
     try:
         # A process group, not a session: a new session is also a new scheduler autogroup on
-        # Linux. With one, CI's experiment.quick took 680-725 s beside the other tests (~200 s
-        # before; 107 s alone); suspected, not yet measured with the group.
+        # Linux. With one, experiment.quick beside four other tests (ctest -j2) took 336 s, with
+        # the group 178 s (one run each, 2 cores; CI with a session: 680-725 s).
         p = subprocess.Popen(cmd, process_group=0)
         group.append(p.pid)
         if received:  # arrived before the group existed
