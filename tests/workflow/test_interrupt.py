@@ -23,29 +23,27 @@ exec sleep 300
 """
 
 
-def alive(pid):
-    """True while pid runs (a zombie has finished)."""
+def process_state(pid):
+    """(state letter, process group) of a process from /proc/<pid>/stat, or None once it is gone."""
     try:
         with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except FileNotFoundError:
-        return False
+            fields = f.read().rsplit(")", 1)[1].split()
+    except (FileNotFoundError, ProcessLookupError):
+        return None
+    return fields[0], int(fields[2])
+
+
+def alive(pid):
+    """True while pid runs (a zombie has finished)."""
+    state = process_state(pid)
+    return state is not None and state[0] != "Z"
 
 
 def group_members(pgid):
     """Running (not zombie) processes of process group pgid. kill(-pgid, 0) would count a
     zombie that init has not reaped yet."""
-    members = []
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/stat") as f:
-                    fields = f.read().rsplit(")", 1)[1].split()
-            except (FileNotFoundError, ProcessLookupError):
-                continue
-            if fields[0] != "Z" and int(fields[2]) == pgid:
-                members.append(int(entry))
-    return members
+    states = {int(e): process_state(e) for e in os.listdir("/proc") if e.isdigit()}
+    return [pid for pid, st in states.items() if st and st[0] != "Z" and st[1] == pgid]
 
 
 def wait_until(condition, seconds):
