@@ -39,6 +39,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import experiment_lib as X  # noqa: E402
+
 
 def run_json(cmd):
     return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
@@ -173,8 +176,6 @@ def table1_lines(a, result, measure):
     """experiment_lib's Table 1 of these frames: LPIPS and MSE×100 against r₁ (the experiment's
     protocol: reproduces its cells up to the PNGs' rounding), or against the cleaner references
     (LPIPS against r̄, noise-corrected MSE; floor: the round trip at r̄, noise-corrected)."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import experiment_lib as X
     scene = os.path.basename(os.path.normpath(a.scene_dir))
     if scene not in X.PAPER_TABLE1 or set(result["sequences"]) != set(X.KINDS):
         return [], []
