@@ -103,6 +103,7 @@ int run_viz(const VaeArgs& args);
 
 struct MetricsArgs {
     std::string a, b, vae_dir;
+    std::string pairs;  ///< file of tab-separated pairs ("-": stdin); JSON lines out
     bool json = false;
 };
 int run_metrics(const MetricsArgs&);

@@ -372,10 +372,14 @@ struct Cli {
         metrics = app.add_subcommand("metrics",
                                      "MSE, PSNR, SSIM and LPIPS between two images (PNG display values or linear EXR), "
                                      "or MSE, PSNR and SSIM between two 16-channel latent EXRs");
-        metrics->add_option("a", m.a, "first image or latent EXR")->required()->check(CLI::ExistingFile);
-        metrics->add_option("b", m.b, "second image or latent EXR, same size and kind")
-            ->required()
-            ->check(CLI::ExistingFile);
+        auto* a = metrics->add_option("a", m.a, "first image or latent EXR")->check(CLI::ExistingFile);
+        auto* b =
+            metrics->add_option("b", m.b, "second image or latent EXR, same size and kind")->check(CLI::ExistingFile);
+        metrics
+            ->add_option("--pairs", m.pairs,
+                         "instead of a b: a file of pairs, one per line with the two paths separated by a tab "
+                         "('-': stdin); prints one JSON object per pair, in order, loading LPIPS once")
+            ->excludes(a, b);
         metrics->add_option("--lpips-dir", m.vae_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
         metrics->add_flag("--json", m.json, "print one JSON object instead of text");
     }

@@ -5,6 +5,8 @@
 //     --ref-tone clip does (clip to [0, 1], then x^(1/2.2)). A 4th (alpha) channel is ignored.
 //   * EXR with 16 channels: TAESD3 latents, compared as they are over the data range 6
 //     ([-3, 3], the decoder's soft-clamp range); no LPIPS (it is an RGB metric).
+// `latentpt metrics --pairs FILE` scores many pairs in one process (one JSON line each): loading
+// libtorch and LPIPS costs ~1 s, more than scoring a 1024² pair (scripts/reference_noise.py).
 #include "apps/commands.h"
 #include "core/image_io.h"
 #include "vae/lpips.h"
@@ -15,10 +17,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #ifndef LPT_SOURCE_DIR
 #define LPT_SOURCE_DIR "."
@@ -98,64 +104,134 @@ std::string json_number(const std::optional<double>& v) {
 
 }  // namespace
 
-int run_metrics(const MetricsArgs& args) {
-    Loaded a = load(args.a), b = load(args.b);
+namespace {
+
+struct Scores {
+    Loaded a, b;
+    double range = 0, mse = 0, psnr = 0;
+    std::optional<double> ssim, lpips;
+    std::string ssim_note, lpips_note;
+};
+
+/// LPIPS's weights, loaded on first use and kept: `--pairs` scores many images in one process.
+class LpipsOnce {
+public:
+    explicit LpipsOnce(std::string dir) : dir_(std::move(dir)) {}
+    /// The network, or nullptr with `note` set when no weights are found in the default folder.
+    const Lpips* get(std::string& note) {
+        if (!tried_) {
+            tried_ = true;
+            const std::string dir = default_lpips_dir(dir_);
+            if (dir_.empty() && !fs::exists(dir + "/lpips_squeeze_v0.1.safetensors")) {
+                missing_ = "n/a (no weights in " + dir + "; pass --lpips-dir)";
+                std::cerr << "latentpt metrics: warning: LPIPS weights not found in " << dir << ", LPIPS skipped\n";
+            } else {
+                net_ = Lpips::load(dir);
+            }
+        }
+        if (!net_) note = missing_;
+        return net_.get();
+    }
+
+private:
+    std::string dir_, missing_;
+    bool tried_ = false;
+    std::unique_ptr<Lpips> net_;
+};
+
+Scores score(const std::string& path_a, const std::string& path_b, LpipsOnce& lpips) {
+    Scores s{load(path_a), load(path_b)};
+    const Loaded &a = s.a, &b = s.b;
     if (a.latent != b.latent || a.channels != b.channels)
-        throw std::runtime_error("metrics needs the same kind of data in both files: " + args.a + " is " + a.kind +
-                                 ", " + args.b + " is " + b.kind);
+        throw std::runtime_error("metrics needs the same kind of data in both files: " + path_a + " is " + a.kind +
+                                 ", " + path_b + " is " + b.kind);
     if (a.width != b.width || a.height != b.height)
-        throw std::runtime_error("metrics needs images of the same size: " + args.a + " is " + std::to_string(a.width) +
-                                 "x" + std::to_string(a.height) + ", " + args.b + " is " + std::to_string(b.width) +
+        throw std::runtime_error("metrics needs images of the same size: " + path_a + " is " + std::to_string(a.width) +
+                                 "x" + std::to_string(a.height) + ", " + path_b + " is " + std::to_string(b.width) +
                                  "x" + std::to_string(b.height));
 
-    const double range = a.latent ? kLatentDataRange : kImageDataRange;
+    s.range = a.latent ? kLatentDataRange : kImageDataRange;
     double se = 0;
     for (size_t i = 0; i < a.data.size(); ++i) {
         const double d = double(a.data[i]) - double(b.data[i]);
         se += d * d;
     }
-    const double mse = a.data.empty() ? 0.0 : se / double(a.data.size());
-    const double psnr = mse > 0 ? 10.0 * std::log10(range * range / mse) : std::numeric_limits<double>::infinity();
+    s.mse = a.data.empty() ? 0.0 : se / double(a.data.size());
+    s.psnr = s.mse > 0 ? 10.0 * std::log10(s.range * s.range / s.mse) : std::numeric_limits<double>::infinity();
 
-    std::optional<double> ssim_v, lpips_v;
-    std::string ssim_note, lpips_note;
     if (a.width >= kSsimWindow && a.height >= kSsimWindow)
-        ssim_v = ssim(a.data.data(), b.data.data(), a.width, a.height, a.channels, range);
-    else ssim_note = "n/a (image smaller than the 11x11 window)";
+        s.ssim = ssim(a.data.data(), b.data.data(), a.width, a.height, a.channels, s.range);
+    else s.ssim_note = "n/a (image smaller than the 11x11 window)";
 
-    if (a.latent) lpips_note = "n/a (latents; LPIPS is an RGB metric)";
+    if (a.latent) s.lpips_note = "n/a (latents; LPIPS is an RGB metric)";
     else if (a.width < Lpips::kMinSize || a.height < Lpips::kMinSize)
-        lpips_note =
+        s.lpips_note =
             "n/a (image smaller than " + std::to_string(Lpips::kMinSize) + "x" + std::to_string(Lpips::kMinSize) + ")";
-    else {
-        const std::string dir = default_lpips_dir(args.vae_dir);
-        if (args.vae_dir.empty() && !fs::exists(dir + "/lpips_squeeze_v0.1.safetensors")) {
-            lpips_note = "n/a (no weights in " + dir + "; pass --lpips-dir)";
-            std::cerr << "latentpt metrics: warning: LPIPS weights not found in " << dir << ", LPIPS skipped\n";
-        } else {
-            lpips_v = Lpips::load(dir)->distance(a.data, b.data, a.width, a.height);
-        }
-    }
+    else if (const Lpips* net = lpips.get(s.lpips_note)) s.lpips = net->distance(a.data, b.data, a.width, a.height);
+    return s;
+}
 
-    if (args.json) {
-        std::cout << "{\"a\": " << json_string(args.a) << ", \"b\": " << json_string(args.b)
-                  << ", \"width\": " << a.width << ", \"height\": " << a.height << ", \"channels\": " << a.channels
-                  << ", \"kind\": " << json_string(a.latent ? "latent" : "rgb")
-                  << ", \"data_range\": " << json_number(range) << ", \"mse\": " << json_number(mse)
-                  << ", \"mse_x100\": " << json_number(mse * 100) << ", \"psnr\": " << json_number(psnr)
-                  << ", \"ssim\": " << json_number(ssim_v) << ", \"lpips\": " << json_number(lpips_v) << "}\n";
+void print_json(const std::string& path_a, const std::string& path_b, const Scores& s) {
+    std::cout << "{\"a\": " << json_string(path_a) << ", \"b\": " << json_string(path_b) << ", \"width\": " << s.a.width
+              << ", \"height\": " << s.a.height << ", \"channels\": " << s.a.channels
+              << ", \"kind\": " << json_string(s.a.latent ? "latent" : "rgb")
+              << ", \"data_range\": " << json_number(s.range) << ", \"mse\": " << json_number(s.mse)
+              << ", \"mse_x100\": " << json_number(s.mse * 100) << ", \"psnr\": " << json_number(s.psnr)
+              << ", \"ssim\": " << json_number(s.ssim) << ", \"lpips\": " << json_number(s.lpips) << "}\n";
+}
+
+void print_text(const std::string& path_a, const std::string& path_b, const Scores& s) {
+    std::printf("a: %s (%dx%d, %s)\n", path_a.c_str(), s.a.width, s.a.height, s.a.kind.c_str());
+    std::printf("b: %s (%dx%d, %s)\n", path_b.c_str(), s.b.width, s.b.height, s.b.kind.c_str());
+    std::printf("MSE       %.6g\n", s.mse);
+    std::printf("MSE x100  %.6g\n", s.mse * 100);
+    if (std::isfinite(s.psnr)) std::printf("PSNR      %.4f dB (data range %g)\n", s.psnr, s.range);
+    else std::printf("PSNR      inf (identical)\n");
+    if (s.ssim) std::printf("SSIM      %.6f (11x11 Gaussian, sigma 1.5, data range %g)\n", *s.ssim, s.range);
+    else std::printf("SSIM      %s\n", s.ssim_note.c_str());
+    if (s.lpips) std::printf("LPIPS     %.6f (v0.1, SqueezeNet)\n", *s.lpips);
+    else std::printf("LPIPS     %s\n", s.lpips_note.c_str());
+}
+
+/// `--pairs FILE`: one pair per line, the two paths separated by a tab (paths may hold spaces);
+/// empty lines are skipped. Every pair is checked to exist before any is scored.
+std::vector<std::pair<std::string, std::string>> read_pairs(const std::string& file) {
+    std::ifstream in_file;
+    if (file != "-") {
+        in_file.open(file);
+        if (!in_file) throw std::runtime_error(file + ": cannot open the --pairs file");
+    }
+    std::istream& in = file == "-" ? std::cin : in_file;
+    std::vector<std::pair<std::string, std::string>> pairs;
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) continue;
+        const size_t tab = line.find('\t');
+        if (tab == std::string::npos || line.find('\t', tab + 1) != std::string::npos)
+            throw std::runtime_error(file + ":" + std::to_string(n) + ": expected two paths separated by one tab");
+        pairs.emplace_back(line.substr(0, tab), line.substr(tab + 1));
+        for (const std::string& p : {pairs.back().first, pairs.back().second})
+            if (!fs::exists(p)) throw std::runtime_error(file + ":" + std::to_string(n) + ": " + p + " not found");
+    }
+    return pairs;
+}
+
+}  // namespace
+
+int run_metrics(const MetricsArgs& args) {
+    LpipsOnce lpips(args.vae_dir);
+    if (!args.pairs.empty()) {
+        if (!args.a.empty() || !args.b.empty())
+            throw std::runtime_error("metrics: give two files or --pairs, not both");
+        // One JSON object per line, in the file's order; the weights are loaded once.
+        for (const auto& [a, b] : read_pairs(args.pairs)) print_json(a, b, score(a, b, lpips));
         return 0;
     }
-    std::printf("a: %s (%dx%d, %s)\n", args.a.c_str(), a.width, a.height, a.kind.c_str());
-    std::printf("b: %s (%dx%d, %s)\n", args.b.c_str(), b.width, b.height, b.kind.c_str());
-    std::printf("MSE       %.6g\n", mse);
-    std::printf("MSE x100  %.6g\n", mse * 100);
-    if (std::isfinite(psnr)) std::printf("PSNR      %.4f dB (data range %g)\n", psnr, range);
-    else std::printf("PSNR      inf (identical)\n");
-    if (ssim_v) std::printf("SSIM      %.6f (11x11 Gaussian, sigma 1.5, data range %g)\n", *ssim_v, range);
-    else std::printf("SSIM      %s\n", ssim_note.c_str());
-    if (lpips_v) std::printf("LPIPS     %.6f (v0.1, SqueezeNet)\n", *lpips_v);
-    else std::printf("LPIPS     %s\n", lpips_note.c_str());
+    if (args.a.empty() || args.b.empty()) throw std::runtime_error("metrics: needs two files a b, or --pairs FILE");
+    const Scores s = score(args.a, args.b, lpips);
+    if (args.json) print_json(args.a, args.b, s);
+    else print_text(args.a, args.b, s);
     return 0;
 }
 

@@ -103,6 +103,22 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" encode "$out/e.png" -q --out "$out/lat.exr"; check test -s "$out/lat.exr"
     check test "$("$bin" decode "$out/lat.exr" -q --out "$out/dec.png" && oiiotool --info "$out/dec.png" | grep -c '32 x   16')" -eq 1
     "$bin" viz "$out/lat.exr" -q --out "$out/viz.png"; check test -s "$out/viz.png"
+    # metrics --pairs: one JSON line per pair (empty lines skipped), each what a call of its own
+    # prints; an image against itself scores 0, LPIPS too (24² is above LPIPS's smallest size).
+    "$bin" render "$scene" --spp 1 --res 24x24 -q --out "$out/m1.exr"
+    "$bin" render "$scene" --spp 1 --res 24x24 --seed 2 -q --out "$out/m2.exr"
+    printf '%s\t%s\n\n%s\t%s\n' "$out/m1.png" "$out/m2.png" "$out/m2.png" "$out/m2.png" > "$out/pairs.txt"
+    "$bin" metrics --pairs "$out/pairs.txt" > "$out/pairs.jsonl"
+    "$bin" metrics "$out/m1.png" "$out/m2.png" --json > "$out/one.json"
+    check test "$(wc -l < "$out/pairs.jsonl")" -eq 2
+    check sh -c "head -1 '$out/pairs.jsonl' | cmp -s - '$out/one.json'"
+    check sh -c "! grep -q '\"lpips\": null' '$out/one.json'"
+    check sh -c "sed -n 2p '$out/pairs.jsonl' | grep -q '\"mse\": 0,.*\"lpips\": 0}'"
+    printf '%s %s\n' "$out/m1.png" "$out/m2.png" > "$out/bad_pairs.txt"
+    expect_error "bad_pairs.txt:1: expected two paths separated by one tab" "$bin" metrics --pairs "$out/bad_pairs.txt"
+    printf '%s\t%s\n' "$out/m1.png" "$out/nope.png" > "$out/bad_pairs.txt"
+    expect_error "nope.png not found" "$bin" metrics --pairs "$out/bad_pairs.txt"
+    expect_error "excludes" "$bin" metrics "$out/m1.png" "$out/m2.png" --pairs "$out/pairs.txt"
     # The TorchScript VAE path from the command line: TAESD3 exported by our script encodes alike.
     py=/usr/bin/python3; [ -x "$py" ] || py=python3
     if "$py" -c 'import torch' 2>/dev/null && "$py" "$src/tools/export_taesd3.py" --weights "$shared/models/taesd3" --out "$out/ts" >/dev/null; then
