@@ -133,6 +133,10 @@ def main():
                     help="every fit's --emission-decay (default: the preset's, else 0; docs/fitting.md (17))")
     ap.add_argument("--emitter-response-decay", type=float, default=None,
                     help="every fit's --emitter-response-decay (default: the preset's, else 0; docs/fitting.md (18))")
+    ap.add_argument("--second-references", action="store_true",
+                    help="also trace every scored frame's reference again with another seed and add Table 1 against "
+                         "the cleaner references (their mean in LPIPS, noise-corrected MSE) to the summary; costs about "
+                         "the edit stage's time again (docs/metrics.md \"Reference noise\")")
     ap.add_argument("--chunk", type=int, default=8, help="frames per edit job (the unit a cluster spreads)")
     ap.add_argument("--cores", type=int, default=os.cpu_count(),
                     help="cores per job (every job uses all of them; locally: the machine's)")
@@ -145,7 +149,7 @@ def main():
                    shared=a.shared, image_res=a.image_res, frames=a.frames, ref_spp=a.ref_spp,
                    fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk,
                    paper=a.paper, frame_step=a.frame_step, emission_decay=a.emission_decay, param=a.param,
-                   emitter_response_decay=a.emitter_response_decay)
+                   emitter_response_decay=a.emitter_response_decay, second_references=a.second_references)
     for s in c["scenes"]:
         if s not in X.SCENES:
             sys.exit(f"experiment: unknown scene '{s}' (have {', '.join(X.SCENES)})")

@@ -85,6 +85,31 @@ def table1(c, summary):
     return md, misses
 
 
+# --second-references (docs/metrics.md "Reference noise"): every scored frame's reference traced
+# again with this --ref-seed (render --edit of the eac fit into <scene>/noise_seed1/<kind>), then
+# scripts/reference_noise.py --ablation, for Table 1 against references with half the noise.
+NOISE_SEED = 1
+NOISE_DIR = f"noise_seed{NOISE_SEED}"
+
+
+def noise_table1_entry(result, measure):
+    """table1()'s entry of one scene from reference_noise.py's result: the four columns against
+    r₁ (measure "r1", the experiment's protocol) or against the cleaner references ("clean": LPIPS
+    against r̄ = ½ (r₁ + r₂), noise-corrected MSE×100; floor: r̄'s own round trip in LPIPS, the
+    noise-corrected round trip in MSE×100)."""
+    lpips_key, mse_key = ("lpips_r1", "mse_r1") if measure == "r1" else ("lpips_mean_ref", "mse_corrected")
+    fl = result["floor"]
+    floor = (fl["lpips_r1"], fl["mse_r1"]) if measure == "r1" else (fl["lpips_mean_ref_roundtrip"], fl["mse_r2_corrected"])
+
+    def column(rows, k, key):
+        return sum(r[k][key] for r in rows) / len(rows)
+
+    edits = {seq: {k: {"rgb_lpips": column(rows, k, lpips_key), "rgb_mse_x100": column(rows, k, mse_key)}
+                   for k in rows[0] if k not in ("frame", "sigma2_x100")}
+             for seq, rows in result["sequences"].items()}
+    return {"training_view": {"vae_roundtrip": {"rgb_lpips": floor[0], "rgb_mse_x100": floor[1]}}, "edits": edits}
+
+
 def read_metrics(path):
     with open(path) as f:
         return list(csv.DictReader(f))
@@ -153,10 +178,11 @@ def run_logged(cmd, log, who):
         sys.exit(f"{who}: command failed (exit {r.returncode}), see {log}: {' '.join(cmd)}")
 
 
-def write_outputs(out, c, summary, failures, timings):
+def write_outputs(out, c, summary, failures, timings, noise=None):
     """summary.md/json, the SVG plots and report.html under `out`. summary.json holds results
     only (no timings: a cluster run and a local run of one config give the same file);
-    timings.json holds the job times."""
+    timings.json holds the job times. noise: reference_noise.py's result per scene
+    (--second-references), for Table 1 against the cleaner references."""
     image_res, fit_its, ref_its, frames = c["image_res"], c["fit_iterations"], c["refiner_iterations"], c["frames"]
     # Tables (markdown) and plots.
     colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
@@ -215,10 +241,15 @@ def write_outputs(out, c, summary, failures, timings):
         md += ["", "Targets (issue 16): " + ("all met." if not misses else f"{len(misses)} missed:"), ""]
         md += [f"- {x}" for x in misses]
         md.append("")
+    if noise:
+        md += cleaner_table1_lines(c, noise)
     if failures:
         md += ["## Ordering check failed", ""] + [f"- {x}" for x in failures]
     write_atomic(os.path.join(out, "summary.md"), "\n".join(md) + "\n")
-    write_atomic(os.path.join(out, "summary.json"), json.dumps({"scenes": summary, "failures": failures}, indent=1))
+    results = {"scenes": summary, "failures": failures}
+    if noise:
+        results["reference_noise"] = noise
+    write_atomic(os.path.join(out, "summary.json"), json.dumps(results, indent=1))
     write_atomic(os.path.join(out, "timings.json"), json.dumps(timings, indent=1))
 
     # Self-contained HTML report.
@@ -261,6 +292,25 @@ def write_outputs(out, c, summary, failures, timings):
 
 
 
+def cleaner_table1_lines(c, noise):
+    """summary.md's section of Table 1 against two references per scored frame: each scene's
+    references' own variance, the table, its target misses."""
+    md = ["## Table 1 against two references per frame (--second-references)", "",
+          f"Every scored frame traced again with --ref-seed {NOISE_SEED} (<scene>/{NOISE_DIR}/, "
+          "scripts/reference_noise.py): LPIPS against the mean of both references r̄ (twice the spp), "
+          "MSE×100 less the references' own noise (an estimate against the converged image, docs/metrics.md "
+          "\"Reference noise\"); the floor is r̄'s own VAE round trip in LPIPS, the noise-corrected round trip in "
+          "MSE×100. A reference's variance σ²×100 (mean over the scored frames): " +
+          ", ".join(f"{scene} {sum(r['sigma2_x100'] for rows in n['sequences'].values() for r in rows) / sum(len(rows) for rows in n['sequences'].values()):.4f}"
+                    for scene, n in noise.items()) + ".", ""]
+    entries = {scene: noise_table1_entry(n, "clean") for scene, n in noise.items()}
+    if not all(scene in PAPER_TABLE1 and set(e["edits"]) == set(KINDS) for scene, e in entries.items()):
+        return md + ["(no Table 1: it needs the three edit sequences of the paper's scenes)", ""]
+    t1, misses = table1(c, entries)
+    return md + t1 + ["", "Targets against these references: " + ("all met." if not misses else f"{len(misses)} missed:"), ""] + \
+        [f"- {x}" for x in misses] + [""]
+
+
 # ---- the workflow's configuration and jobs ----
 
 # The paper-scale preset (issue 16, docs/results.md "Table 1 at the paper's scale"): the paper's
@@ -282,7 +332,7 @@ PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
              fit_iterations=None, refiner_iterations=None, spp=64, chunk=8, paper=False, frame_step=None,
-             emission_decay=None, emitter_response_decay=None, param=None):
+             emission_decay=None, emitter_response_decay=None, param=None, second_references=False):
     """The workflow's config (JSON-able): --quick's small sizes, --paper's preset or the full run's;
     flags given explicitly win over the preset's values."""
     p = PAPER if paper else {}
@@ -303,7 +353,7 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "spp_list": [1, 16] if quick else p.get("spp_list", [1, 4, 16, 64, 256, 1024]), "chunk": chunk,
             # --quick: its RGB side reaches the latent floor by 2-4 spp at 128²; 1024 cost a minute of CI
             "equal_error_max_spp": p.get("equal_error_max_spp", 128 if quick else 1024),
-            "conv_views": p.get("conv_views", ["training", "novel"])}
+            "conv_views": p.get("conv_views", ["training", "novel"]), "second_references": second_references}
 
 
 def image_res_of(c, scene):
@@ -433,6 +483,26 @@ def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
                                 ref_spp_of(c, scene), os.path.join(scene, "refs"), spec))
 
 
+def second_reference_command(c, scene, kind, threads):
+    """--second-references: the eac fit's render of one sequence's scored frames against references
+    traced with --ref-seed NOISE_SEED (cached in <scene>/refs beside the first ones, named _seed1)."""
+    cmd = edit_argv(c["bin"], threads, os.path.join(scene, "fit_eac"), os.path.join(scene, f"edits-{kind}.json"),
+                    os.path.join(scene, NOISE_DIR, kind), c["spp"], ref_spp_of(c, scene), os.path.join(scene, "refs"),
+                    frames_arg(c, scene, kind))
+    return shlex.join(cmd + ["--ref-seed", str(NOISE_SEED)])
+
+
+def reference_noise_command(c, scene):
+    """scripts/reference_noise.py --ablation on the scene's scored frames and both references."""
+    frames = {kind: frames_evaluated(c, scene, kind) for kind in KINDS}
+    if any(f != frames[KINDS[0]] for f in frames.values()):
+        raise ValueError(f"{scene}: --second-references needs the same frames in every edit sequence, have {frames}")
+    return shlex.join([sys.executable, os.path.join(ROOT, "scripts", "reference_noise.py"), "--scene-dir", scene,
+                       "--seed-dir", NOISE_DIR, "--seed", str(NOISE_SEED), "--ablation", "--size", str(image_res_of(c, scene)),
+                       "--ref-spp", str(ref_spp_of(c, scene)), "--frames", ",".join(map(str, frames[KINDS[0]])),
+                       "--bin", c["bin"]])
+
+
 def edit_sequence(c, scene, kind):
     """The edit file of a sequence, with the frame count of this config."""
     with open(os.path.join(c["root"], "scenes", scene, f"edits-{kind}.json")) as f:
@@ -509,7 +579,8 @@ def scene_summary(c, out, scene, failures):
     return s
 
 
-STAGES = {"fit": "fits", "edit": "edits (references + renders)", "conv": "convergence", "equal": "equal-error benchmark"}
+STAGES = {"fit": "fits", "edit": "edits (references + renders)", "conv": "convergence", "equal": "equal-error benchmark",
+          "noise": "second references (+ their scores)"}
 
 
 def job_times(out, scene):
@@ -526,9 +597,12 @@ def job_times(out, scene):
 
 def write_summary(c, out):
     """summary.md, summary.json, timings.json, plots and report.html of every scene of `c`."""
-    failures, summary, timings = [], {}, {}
+    failures, summary, timings, noise = [], {}, {}, {}
     for scene in c["scenes"]:
         summary[scene] = scene_summary(c, out, scene, failures)
         with open(os.path.join(out, scene, "equal_error.txt")) as f:  # timings: not in summary.json
             timings[scene] = {"stages": job_times(out, scene), "equal_error": f.read()}
-    return write_outputs(out, c, summary, failures, timings), failures
+        if c.get("second_references"):
+            with open(os.path.join(out, scene, NOISE_DIR, "reference_noise.json")) as f:
+                noise[scene] = json.load(f)
+    return write_outputs(out, c, summary, failures, timings, noise), failures

@@ -43,8 +43,25 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import experiment_lib as X  # noqa: E402
 
 
-def run_json(cmd):
-    return json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+class Scorer:
+    """Image pairs scored by one `latentpt metrics --pairs` process: add() every pair first, then
+    run() (a process per pair spent ~1 s of its time loading libtorch and LPIPS)."""
+
+    def __init__(self, binary, tmp):
+        self.binary, self.tmp, self.pairs = binary, tmp, []
+
+    def add(self, a, b):
+        self.pairs.append((a, b))
+        return len(self.pairs) - 1
+
+    def run(self):
+        listing = os.path.join(self.tmp, "pairs.txt")
+        with open(listing, "w") as f:
+            f.writelines(f"{a}\t{b}\n" for a, b in self.pairs)
+        out = subprocess.run([self.binary, "metrics", "--pairs", listing], check=True, capture_output=True, text=True).stdout
+        scores = [json.loads(line) for line in out.splitlines()]
+        assert len(scores) == len(self.pairs), f"latentpt metrics --pairs scored {len(scores)} of {len(self.pairs)} pairs"
+        return scores
 
 
 def display_png(exr, png):
@@ -64,12 +81,13 @@ def reference_stem(refs, sequence, size, spp, frame, seed_suffix=""):
 
 
 def frame_row(m, x_png, r1, r2, rbar, r12):
-    """One decoded frame x against the two references and their mean; MSE×100 values."""
+    """One decoded frame x against the two references and their mean (`m` adds a pair to score and
+    returns a function giving its scores); returns a function giving its row of MSE×100 values."""
     a, b, c = m(x_png, r1), m(x_png, r2), m(x_png, rbar)
-    return {
-        "mse_r1": a["mse_x100"], "mse_r2": b["mse_x100"], "mse_mean_ref": c["mse_x100"],
-        "mse_corrected": c["mse_x100"] - 0.25 * r12,
-        "lpips_r1": a["lpips"], "lpips_r2": b["lpips"], "lpips_mean_ref": c["lpips"],
+    return lambda: {
+        "mse_r1": a()["mse_x100"], "mse_r2": b()["mse_x100"], "mse_mean_ref": c()["mse_x100"],
+        "mse_corrected": c()["mse_x100"] - 0.25 * r12()["mse_x100"],
+        "lpips_r1": a()["lpips"], "lpips_r2": b()["lpips"], "lpips_mean_ref": c()["lpips"],
     }
 
 
@@ -122,10 +140,13 @@ def main():
     refs = os.path.join(a.scene_dir, "refs")
     frames = [int(f) for f in a.frames.split(",")]
     out = os.path.join(a.scene_dir, a.seed_dir)
-    result = {"sequences": {}, "floor": {}}
     with tempfile.TemporaryDirectory() as tmp:
-        def m(x, y):
-            return run_json([a.bin, "metrics", x, y, "--json"])
+        scorer = Scorer(a.bin, tmp)
+        scores = []
+
+        def m(x, y):  # scored later, all pairs in one process
+            i = scorer.add(x, y)
+            return lambda: scores[i]
 
         def refs_of(seq, f):
             s1 = reference_stem(refs, seq, a.size, a.ref_spp, f)
@@ -134,7 +155,7 @@ def main():
             for exr, png in ((s1 + ".exr", r1), (s2 + ".exr", r2)):
                 display_png(exr, png)
             mean_png(r1, r2, rbar)
-            return s1, r1, r2, rbar, m(r1, r2)["mse_x100"]
+            return s1, r1, r2, rbar, m(r1, r2)
 
         columns_by_seq = {seq: columns_of(a, a.scene_dir, seq, frames) for seq in a.sequences.split(",")}
         for seq, f in [(seq, f) for seq in columns_by_seq for f in frames] + [("training", 0)]:
@@ -142,17 +163,20 @@ def main():
                 exr = reference_stem(refs, seq, a.size, a.ref_spp, f, suffix) + ".exr"
                 if not os.path.exists(exr):
                     sys.exit(f"{exr}: missing (run render --edit --reference --ref-seed {a.seed} first)")
+        pending = {}
         for seq, columns in columns_by_seq.items():
-            rows = []
             for f in frames:
                 s1, r1, r2, rbar, r12 = refs_of(seq, f)
-                row = {"frame": f, "sigma2_x100": 0.5 * r12}
-                for kind, (folder, png) in columns.items():
-                    row[kind] = frame_row(m, os.path.join(folder, png.format(f=f)), r1, r2, rbar, r12)
-                rows.append(row)
-                print(seq, f, json.dumps(row), flush=True)
-            result["sequences"][seq] = rows
-        result["floor"] = round_trip_floor(a, m, refs_of, tmp)
+                pending[seq, f] = (r12, {kind: frame_row(m, os.path.join(folder, png.format(f=f)), r1, r2, rbar, r12)
+                                         for kind, (folder, png) in columns.items()})
+        floor = round_trip_floor(a, m, refs_of, tmp)
+        scores += scorer.run()
+    result = {"sequences": {}, "floor": floor()}
+    for (seq, f), (r12, row_of) in pending.items():
+        row = {"frame": f, "sigma2_x100": 0.5 * r12()["mse_x100"]}
+        row.update({kind: get() for kind, get in row_of.items()})
+        result["sequences"].setdefault(seq, []).append(row)
+        print(seq, f, json.dumps(row), flush=True)
     write_report(out, a, result)
 
 
@@ -160,35 +184,26 @@ def round_trip_floor(a, m, refs_of, tmp):
     """The VAE round trip of the training view: dec(enc(r₁)) against r₂ less σ² is its distance
     from the converged view; against r₁ it is what the table calls the floor. LPIPS has no
     correction: dec(enc(r̄)) against r̄ is the round trip at twice the spp, the floor of the
-    LPIPS-against-r̄ columns."""
+    LPIPS-against-r̄ columns. Returns a function giving it once the pairs are scored."""
     s1, r1, r2, rbar, r12 = refs_of("training", 0)
     rt, rt_mean, latent_mean = (os.path.join(tmp, n) for n in ("roundtrip.png", "roundtrip_mean.png", "mean.exr"))
     subprocess.run([a.bin, "decode", s1 + "_latent.exr", "-o", rt, "-q"], check=True)
     subprocess.run([a.bin, "encode", rbar, "-o", latent_mean, "-q"], check=True)
     subprocess.run([a.bin, "decode", latent_mean, "-o", rt_mean, "-q"], check=True)
     f1, f2, fm = m(rt, r1), m(rt, r2), m(rt_mean, rbar)
-    return {"mse_r1": f1["mse_x100"], "mse_r2_corrected": f2["mse_x100"] - 0.5 * r12,
-            "lpips_r1": f1["lpips"], "lpips_r2": f2["lpips"], "lpips_mean_ref_roundtrip": fm["lpips"],
-            "sigma2_x100": 0.5 * r12}
+    return lambda: {"mse_r1": f1()["mse_x100"], "mse_r2_corrected": f2()["mse_x100"] - 0.5 * r12()["mse_x100"],
+                    "lpips_r1": f1()["lpips"], "lpips_r2": f2()["lpips"], "lpips_mean_ref_roundtrip": fm()["lpips"],
+                    "sigma2_x100": 0.5 * r12()["mse_x100"]}
 
 
 def table1_lines(a, result, measure):
     """experiment_lib's Table 1 of these frames: LPIPS and MSE×100 against r₁ (the experiment's
     protocol: reproduces its cells up to the PNGs' rounding), or against the cleaner references
-    (LPIPS against r̄, noise-corrected MSE; floor: the round trip at r̄, noise-corrected)."""
+    (X.noise_table1_entry)."""
     scene = os.path.basename(os.path.normpath(a.scene_dir))
     if scene not in X.PAPER_TABLE1 or set(result["sequences"]) != set(X.KINDS):
         return [], []
-    lpips_key, mse_key = ("lpips_r1", "mse_r1") if measure == "r1" else ("lpips_mean_ref", "mse_corrected")
-    fl = result["floor"]
-    floor = ((fl["lpips_r1"], fl["mse_r1"]) if measure == "r1"
-             else (fl["lpips_mean_ref_roundtrip"], fl["mse_r2_corrected"]))
-    edits = {seq: {k: {"rgb_lpips": mean([r[k] for r in rows], lpips_key), "rgb_mse_x100": mean([r[k] for r in rows], mse_key)}
-                   for k in rows[0] if k not in ("frame", "sigma2_x100")}
-             for seq, rows in result["sequences"].items()}
-    summary = {scene: {"training_view": {"vae_roundtrip": {"rgb_lpips": floor[0], "rgb_mse_x100": floor[1]}},
-                       "edits": edits}}
-    return X.table1({"scene_res": {scene: a.size}, "image_res": a.size}, summary)
+    return X.table1({"scene_res": {scene: a.size}, "image_res": a.size}, {scene: X.noise_table1_entry(result, measure)})
 
 
 def write_report(out, a, result):

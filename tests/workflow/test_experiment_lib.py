@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The experiment's bookkeeping (scripts/experiment_lib.py) without running anything: frame
 subsets and their chunks cover each evaluated frame exactly once, the paper preset's values and
-their overrides, and the Table 1 target check failing where it must."""
+their overrides, the Table 1 target check failing where it must, and --second-references' jobs
+and table."""
 import os
 import sys
 import unittest
@@ -105,6 +106,45 @@ class Table1(unittest.TestCase):
             summary["cbox-specular"]["edits"][kind]["eac+refiner"] = {"rgb_lpips": 0.25, "rgb_mse_x100": 0.02}
         _, misses = X.table1(c, summary)
         self.assertEqual(sum("LPIPS: +refiner 0.250 not below +Ĩa 0.200" in m for m in misses), 3)
+
+
+
+class SecondReferences(unittest.TestCase):
+    def result(self):
+        """reference_noise.py's result for two frames: column k's values at frame f are distinct
+        numbers, so a cell built from the wrong key or frame cannot come out right."""
+        def row(f):
+            return {"frame": f, "sigma2_x100": 0.1 + f,
+                    **{k: {"mse_r1": 1 + i + f, "mse_corrected": 10 + i + f, "lpips_r1": 0.1 * i + f,
+                           "lpips_mean_ref": 0.01 * i + f, "mse_r2": 0, "mse_mean_ref": 0, "lpips_r2": 0}
+                       for i, (k, _) in enumerate(X.TABLE1_COLUMNS)}}
+        return {"sequences": {kind: [row(0), row(2)] for kind in X.KINDS},
+                "floor": {"mse_r1": 0.5, "mse_r2_corrected": 0.4, "lpips_r1": 0.05, "lpips_r2": 0.06,
+                          "lpips_mean_ref_roundtrip": 0.03, "sigma2_x100": 0.1}}
+
+    def test_cells_are_frame_means_of_the_measure(self):
+        for measure, lpips, mse, floor in (("r1", lambda i: 0.1 * i + 1, lambda i: 1 + i + 1, (0.05, 0.5)),
+                                           ("clean", lambda i: 0.01 * i + 1, lambda i: 10 + i + 1, (0.03, 0.4))):
+            entry = X.noise_table1_entry(self.result(), measure)
+            self.assertEqual(entry["training_view"]["vae_roundtrip"], {"rgb_lpips": floor[0], "rgb_mse_x100": floor[1]})
+            for i, (k, _) in enumerate(X.TABLE1_COLUMNS):
+                cell = entry["edits"]["light"][k]
+                self.assertAlmostEqual(cell["rgb_lpips"], lpips(i), msg=(measure, k))
+                self.assertAlmostEqual(cell["rgb_mse_x100"], mse(i), msg=(measure, k))
+
+    def test_summary_section_and_commands(self):
+        c = X.settings(paper=True, scenes=["cbox-specular"], second_references=True)
+        md = X.cleaner_table1_lines(c, {"cbox-specular": self.result()})
+        self.assertIn("cbox-specular 1.1000", md[2])  # σ² over both frames of every sequence
+        self.assertTrue(any(line.startswith("| Cornell Box 1024² | camera |") for line in md), md)
+        cmd = X.second_reference_command(c, "cbox-specular", "light", 2)
+        for part in ("cbox-specular/fit_eac --edit cbox-specular/edits-light.json", "--ref-spp 512", "--ref-seed 1",
+                     "--out cbox-specular/noise_seed1/light", "--frames 0:45:15", "--resume"):
+            self.assertIn(part, cmd)
+        cmd = X.reference_noise_command(c, "cbox-specular")
+        for part in ("--scene-dir cbox-specular --seed-dir noise_seed1 --seed 1 --ablation --size 1024 --ref-spp 512",
+                     "--frames 0,15,30,45"):
+            self.assertIn(part, cmd)
 
 
 if __name__ == "__main__":

@@ -11,10 +11,11 @@ seed) must really differ from what it copied. 60 s in CI (2 cores).
   own loss (MSE + D-SSIM), and a second run asking other iterations of that folder is an error.
 - seed_spread: seed 0 (the experiment's fits, rendered again) = the experiment's e and ea means;
   seed 1 refits with seed 1 and lands elsewhere.
-- reference_noise --ablation: second references of frame 2 (and the training view) with another
-  seed; against the first ones its four Table 1 columns are the experiment's metrics.csv cells,
-  the parallelogram law ties the MSE against the mean reference to the two MSEs and the
-  references' spread, and the spread is not zero.
+- experiment.py --second-references on a copy of the finished experiment: runs only the second
+  references' jobs and reference_noise --ablation (a second run, nothing); against the first
+  references its four Table 1 columns are the experiment's metrics.csv cells, the parallelogram
+  law ties the MSE against the mean reference to the two MSEs and the references' spread, and
+  the spread is not zero.
 Exit 77 (skipped) without the experiment's folder."""
 import argparse
 import csv
@@ -98,41 +99,59 @@ def check_seed_spread(scene_dir, edits):
         assert json.load(f).get("seed") == 1, "seed_spread's seed-1 fit does not record seed 1"
 
 
-def check_reference_noise(a, src, scene_dir):
-    """reference_noise.py --ablation on frame 2 of the three sequences (quick: 128², 32 spp)."""
-    refs = os.path.join(scene_dir, "refs")
-    for kind in ALL_KINDS:
-        shutil.copytree(os.path.join(src, SCENE, f"{kind}_e"), os.path.join(scene_dir, f"{kind}_e"), dirs_exist_ok=True)
-        for fit in ("ea", "eac"):
-            shutil.copytree(os.path.join(src, SCENE, f"{kind}_{fit}"), os.path.join(scene_dir, f"{kind}_{fit}"),
-                            dirs_exist_ok=True)
-        edits = os.path.join(src, SCENE, f"edits-{kind}.json")
-        subprocess.run([a.bin, "render", os.path.join(scene_dir, "fit_eac"), "--edit", edits, "--reference",
-                        "--ref-spp", "32", "--ref-seed", "1", "--reference-cache", refs, "--spp", "4", "-q",
-                        "--out", os.path.join(scene_dir, "noise_seed1", kind),
-                        "--frames", "0:2:2" if kind == "camera" else "2:2"], check=True, stdout=subprocess.DEVNULL)
-    subprocess.run(script("reference_noise.py", "--scene-dir", scene_dir, "--seed-dir", "noise_seed1", "--ablation",
-                          "--size", "128", "--ref-spp", "32", "--frames", "2", "--bin", a.bin),
-                   check=True, stdout=subprocess.DEVNULL)
+def benchmarks(out):
+    """{benchmark file: mtime} of the scene's jobs: which jobs a workflow run ran."""
+    d = os.path.join(out, SCENE, "benchmarks")
+    return {n: os.path.getmtime(os.path.join(d, n)) for n in os.listdir(d)}
+
+
+def check_second_references(a, src, out):
+    """experiment.py --second-references on a copy of the quick experiment: it runs the second
+    references' jobs and the scores alone (every other job is kept), a second run runs nothing;
+    against the first references its four Table 1 columns are the experiment's metrics.csv cells
+    on every scored frame, the parallelogram law ties the MSE against the mean reference to the
+    two MSEs and the references' spread, the spread is not zero, and summary.md holds the table."""
+    shutil.rmtree(out, ignore_errors=True)
+    shutil.copytree(src, out, symlinks=True)
+    with open(os.path.join(out, "experiment-config.json")) as f:
+        config = json.load(f)
+    before = benchmarks(out)
+    run = script("experiment.py", "--quick", "--second-references", "--bin", config["bin"], "--shared", config["shared"],
+                 "--out", out)
+    subprocess.run(run, check=True, stdout=subprocess.DEVNULL)
+    after = benchmarks(out)
+    ran = sorted(n for n in after if before.get(n) != after[n])
+    assert ran == sorted([f"noise_{kind}.tsv" for kind in ALL_KINDS] + ["noise_scores.tsv"]), \
+        f"--second-references on a finished experiment ran {ran}"
+    subprocess.run(run, check=True, stdout=subprocess.DEVNULL)
+    assert benchmarks(out) == after, "a second run of a finished --second-references experiment ran jobs again"
+    scene_dir = os.path.join(out, SCENE)
     with open(os.path.join(scene_dir, "noise_seed1", "reference_noise.json")) as f:
         result = json.load(f)
     cells = {"e": ("e", "rgb_"), "ea": ("ea", "rgb_"), "eac": ("eac", "rgb_"), "eac+refiner": ("eac", "refined_rgb_")}
     for kind in ALL_KINDS:
-        (row,) = result["sequences"][kind]
-        assert row["sigma2_x100"] > 0, f"{kind}: the seed-1 reference equals the first one"
-        for col, (fit, prefix) in cells.items():
-            with open(os.path.join(scene_dir, f"{kind}_{fit}", "metrics.csv")) as f:
-                theirs = next(r for r in csv.DictReader(f) if r["frame"] == "2")
-            ours = row[col]
-            # PNG rounding: the experiment scores its float frames, the script their PNGs
-            assert close(ours["mse_r1"], float(theirs[prefix + "mse_x100"]), 2e-3) and \
-                abs(ours["lpips_r1"] - float(theirs[prefix + "lpips"])) < 2e-3, \
-                f"{kind}/{col} against r1: {ours} against the experiment's {theirs}"
-            law = 0.5 * (ours["mse_r1"] + ours["mse_r2"]) - 0.5 * row["sigma2_x100"]
-            assert close(ours["mse_mean_ref"], law, 1e-2), f"{kind}/{col}: parallelogram law {ours} against {law}"
+        rows = result["sequences"][kind]
+        assert [r["frame"] for r in rows] == [0, 1, 2], f"{kind}: scored frames {[r['frame'] for r in rows]}"
+        for row in rows:
+            assert row["sigma2_x100"] > 0, f"{kind} frame {row['frame']}: the seed-1 reference equals the first one"
+            for col, (fit, prefix) in cells.items():
+                with open(os.path.join(scene_dir, f"{kind}_{fit}", "metrics.csv")) as f:
+                    theirs = next(r for r in csv.DictReader(f) if int(r["frame"]) == row["frame"])
+                ours = row[col]
+                # PNG rounding: the experiment scores its float frames, the script their PNGs
+                assert close(ours["mse_r1"], float(theirs[prefix + "mse_x100"]), 2e-3) and \
+                    abs(ours["lpips_r1"] - float(theirs[prefix + "lpips"])) < 2e-3, \
+                    f"{kind}/{col} frame {row['frame']} against r1: {ours} against the experiment's {theirs}"
+                law = 0.5 * (ours["mse_r1"] + ours["mse_r2"]) - 0.5 * row["sigma2_x100"]
+                assert close(ours["mse_mean_ref"], law, 1e-2), f"{kind}/{col}: parallelogram law {ours} against {law}"
     with open(os.path.join(scene_dir, "noise_seed1", "reference_noise.md")) as f:
         md = f.read()
     assert "## Table 1 against r₁" in md and "## Table 1 against the cleaner references" in md, md
+    with open(os.path.join(out, "summary.md")) as f:
+        summary = f.read()
+    assert "## Table 1 against two references per frame" in summary, summary
+    with open(os.path.join(out, "summary.json")) as f:
+        assert json.load(f)["reference_noise"][SCENE] == result, "summary.json lacks the reference_noise result"
 
 
 def main():
@@ -148,7 +167,7 @@ def main():
     scene_dir = os.path.join(a.out, SCENE)
     check_refiner_study(a, scene_dir, edits)
     check_seed_spread(scene_dir, edits)
-    check_reference_noise(a, a.experiment, scene_dir)
+    check_second_references(a, a.experiment, a.out + "-second-references")
     print("test_studies: the three studies reproduce the experiment's cells and add what they say")
     return 0
 
