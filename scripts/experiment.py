@@ -135,8 +135,8 @@ def main():
                     help="every fit's --emitter-response-decay (default: the preset's, else 0; docs/fitting.md (18))")
     ap.add_argument("--second-references", action="store_true",
                     help="also trace every scored frame's reference again with another seed and add Table 1 against "
-                         "the cleaner references (their mean in LPIPS, noise-corrected MSE) to the summary; costs about "
-                         "the edit stage's time again (docs/metrics.md \"Reference noise\")")
+                         "these independent references (MSE less their noise) to the summary; costs about the edit "
+                         "stage's time again (docs/metrics.md \"Reference noise\")")
     ap.add_argument("--chunk", type=int, default=8, help="frames per edit job (the unit a cluster spreads)")
     ap.add_argument("--cores", type=int, default=os.cpu_count(),
                     help="cores per job (every job uses all of them; locally: the machine's)")

@@ -13,9 +13,12 @@ E MSE(r₁, r₂) = 2σ² (σ²: a reference's variance per value; r*: its expec
     MSE(x, r*) ≈ MSE(x, r̄) − ¼ MSE(r₁, r₂)                       (noise-corrected)
 
 without bias from the references' noise, up to the display mapping's curvature (r* is the
-expectation of the display-mapped reference, not the display-mapped expectation). LPIPS has no
-such identity: the script prints it against r₁, r₂ and their mean (twice the spp) for the trend.
-The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ².
+expectation of the display-mapped reference, not the display-mapped expectation). That needs x
+independent of both references. r₁ shares its seed with the training view's reference, the fit's
+and the refiner's target, so where the camera holds still r₁'s noise is partly the target's, and
+a refiner reproduces some of it: then only r₂ is independent of x, and MSE(x, r₂) − σ² is the
+unbiased estimate. LPIPS has no such identity: the script prints it against r₁, r₂ and their
+mean (twice the spp). The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ².
 
     python3 scripts/reference_noise.py --scene-dir results-paper/cbox-specular --seed-dir noise_seed1
 
@@ -23,9 +26,9 @@ The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ
         --size 512 --ablation
 
 --ablation scores Table 1's four columns (the e and ea fits' frames, the eac fit's rendered and
-refined frames) and writes the experiment's Table 1 twice: against r₁, as the experiment scores
-(its cells up to the PNGs' rounding), and against the cleaner references, with the targets'
-misses under each.
+refined frames) and writes the experiment's Table 1 three times (experiment_lib.NOISE_MEASURES):
+against r₁, as the experiment scores (its cells up to the PNGs' rounding), against r₂ (MSE less
+σ²), and against both (LPIPS vs r̄, noise-corrected MSE), with the targets' misses under each.
 
 <scene-dir>/<seed-dir>/<sequence>/ are `render <scene-dir>/fit_eac --edit edits-<sequence>.json
 --reference --ref-seed S --reference-cache <scene-dir>/refs` outputs for the same frames as the
@@ -129,7 +132,7 @@ def main():
                    help="edit folder (in --scene-dir) of each sequence holding the decoded frames; {seq} = its name")
     p.add_argument("--ablation", action="store_true",
                    help="score Table 1's four columns ({seq}_e, {seq}_ea, {seq}_eac rendered and refined) instead "
-                        "of --folder's rendered and refined frames, and write Table 1 against the cleaner references")
+                        "of --folder's rendered and refined frames, and write Table 1 against each reference")
     p.add_argument("--report", default="reference_noise", help="report name (.md and .json in the seed dir)")
     p.add_argument("--sequences", default="camera,object,light")
     p.add_argument("--frames", default="0,15,30,45")
@@ -197,9 +200,8 @@ def round_trip_floor(a, m, refs_of, tmp):
 
 
 def table1_lines(a, result, measure):
-    """experiment_lib's Table 1 of these frames: LPIPS and MSE×100 against r₁ (the experiment's
-    protocol: reproduces its cells up to the PNGs' rounding), or against the cleaner references
-    (X.noise_table1_entry)."""
+    """experiment_lib's Table 1 of these frames against the reference X.NOISE_MEASURES[measure]
+    names; against r₁ it reproduces the experiment's cells up to the PNGs' rounding."""
     scene = os.path.basename(os.path.normpath(a.scene_dir))
     if scene not in X.PAPER_TABLE1 or set(result["sequences"]) != set(X.KINDS):
         return [], []
@@ -227,7 +229,8 @@ def write_report(out, a, result):
               f"σ²×100 {fl['sigma2_x100']:.4f}.", ""]
     if a.ablation:
         for measure, title in (("r1", "against r₁ (the experiment's protocol)"),
-                               ("clean", "against the cleaner references (LPIPS vs r̄, MSE×100 noise-corrected)")):
+                               ("r2", "against the independent reference r₂ (LPIPS vs r₂, MSE×100 vs r₂ less σ²)"),
+                               ("mean", "against both references (LPIPS vs r̄, MSE×100 noise-corrected)")):
             md, misses = table1_lines(a, result, measure)
             if md:
                 lines += [f"## Table 1 {title}: {len(misses)} target misses", ""] + md + [""]

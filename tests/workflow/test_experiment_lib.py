@@ -116,15 +116,18 @@ class SecondReferences(unittest.TestCase):
         def row(f):
             return {"frame": f, "sigma2_x100": 0.1 + f,
                     **{k: {"mse_r1": 1 + i + f, "mse_corrected": 10 + i + f, "lpips_r1": 0.1 * i + f,
-                           "lpips_mean_ref": 0.01 * i + f, "mse_r2": 0, "mse_mean_ref": 0, "lpips_r2": 0}
+                           "lpips_mean_ref": 0.01 * i + f, "mse_r2": 100 * i + f, "mse_mean_ref": 0,
+                           "lpips_r2": 0.001 * i + f}
                        for i, (k, _) in enumerate(X.TABLE1_COLUMNS)}}
         return {"sequences": {kind: [row(0), row(2)] for kind in X.KINDS},
                 "floor": {"mse_r1": 0.5, "mse_r2_corrected": 0.4, "lpips_r1": 0.05, "lpips_r2": 0.06,
                           "lpips_mean_ref_roundtrip": 0.03, "sigma2_x100": 0.1}}
 
     def test_cells_are_frame_means_of_the_measure(self):
+        # frames 0 and 2: σ² 0.1 and 2.1; column i's mse_r2 is 100 i + f
         for measure, lpips, mse, floor in (("r1", lambda i: 0.1 * i + 1, lambda i: 1 + i + 1, (0.05, 0.5)),
-                                           ("clean", lambda i: 0.01 * i + 1, lambda i: 10 + i + 1, (0.03, 0.4))):
+                                           ("r2", lambda i: 0.001 * i + 1, lambda i: 100 * i + 1 - 1.1, (0.06, 0.4)),
+                                           ("mean", lambda i: 0.01 * i + 1, lambda i: 10 + i + 1, (0.03, 0.4))):
             entry = X.noise_table1_entry(self.result(), measure)
             self.assertEqual(entry["training_view"]["vae_roundtrip"], {"rgb_lpips": floor[0], "rgb_mse_x100": floor[1]})
             for i, (k, _) in enumerate(X.TABLE1_COLUMNS):
@@ -134,7 +137,7 @@ class SecondReferences(unittest.TestCase):
 
     def test_summary_section_and_commands(self):
         c = X.settings(paper=True, scenes=["cbox-specular"], second_references=True)
-        md = X.cleaner_table1_lines(c, {"cbox-specular": self.result()})
+        md = X.independent_table1_lines(c, {"cbox-specular": self.result()})
         self.assertIn("cbox-specular 1.1000", md[2])  # σ² over both frames of every sequence
         self.assertTrue(any(line.startswith("| Cornell Box 1024² | camera |") for line in md), md)
         cmd = X.second_reference_command(c, "cbox-specular", "light", 2)
