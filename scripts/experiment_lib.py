@@ -51,43 +51,76 @@ PAPER_TABLE1 = {
 TABLE1_COLUMNS = [("e", "Ĩe"), ("ea", "+Ĩa"), ("eac", "+Ĩc"), ("eac+refiner", "+refiner")]
 
 
-def table1(c, summary):
-    """The paper's Table 1 layout, ours beside the paper's value in every cell, each scene's VAE
-    round trip (training view) as the floor, and the issue-16 targets checked per cell: each
+def table1_rows(c, summary):
+    """The paper's Table 1 checked against the issue-16 targets, one row per scene and edit: each
     column better than the one before it in both metrics; refined ≤ the paper's value where the
-    round trip is below it, else ≤ 1.5× the round trip. A column an edit's table lacks (a study
-    that scored only some fits) shows as "–" and is left out of the ordering: it is compared with
-    the nearest column before it that is there. Returns (markdown lines, misses)."""
-    md = ["| scene | edit | " + " | ".join(lab for _, lab in TABLE1_COLUMNS) + " | VAE round trip |",
-          "|---|---|" + "---|" * (len(TABLE1_COLUMNS) + 1)]
-    misses = []
+    round trip (training view) is below it, else ≤ 1.5× the round trip. A column an edit's table
+    lacks (a study that scored only some fits) is None and left out of the ordering: it is
+    compared with the nearest column before it that is there. Returns (rows, misses): a row is
+    {label, kind, ours: [(LPIPS, MSE×100) or None per column], paper, floor, missed: {(column,
+    metric index)}}, misses the target misses as sentences."""
+    rows, misses = [], []
     for scene, s in summary.items():
         rt = s["training_view"].get("vae_roundtrip", {})
         floor = (rt.get("rgb_lpips", float("nan")), rt.get("rgb_mse_x100", float("nan")))
-        res = image_res_of(c, scene)
         for kind in ("camera", "object", "light"):
             table, paper = s["edits"][kind], PAPER_TABLE1[scene][kind]
             ours = [(table[k]["rgb_lpips"], table[k]["rgb_mse_x100"]) if k in table else None for k, _ in TABLE1_COLUMNS]
-            cells = [(f"{o[0]:.3f} / {o[1]:.3f}" if o else "–") + f" ({p[0]:.3f} / {p[1]:.3f})" for o, p in zip(ours, paper)]
-            md.append(f"| {PAPER_NAMES[scene]} {res}² | {kind} | " + " | ".join(cells) + f" | {floor[0]:.3f} / {floor[1]:.3f} |")
+            row = {"label": f"{PAPER_NAMES[scene]} {image_res_of(c, scene)}²", "kind": kind, "ours": ours, "paper": paper,
+                   "floor": floor, "missed": set()}
             present = [j for j, o in enumerate(ours) if o]
             for m, metric in enumerate(("LPIPS", "MSE×100")):
                 for i, j in zip(present, present[1:]):
                     if not ours[j][m] < ours[i][m]:
+                        row["missed"].add((j, m))
                         misses.append(f"{scene}/{kind} {metric}: {TABLE1_COLUMNS[j][1]} {ours[j][m]:.3f} not below "
                                       f"{TABLE1_COLUMNS[i][1]} {ours[i][m]:.3f}")
                 if not ours[-1]:
                     continue
                 bound = paper[-1][m] if floor[m] < paper[-1][m] else 1.5 * floor[m]
                 if not ours[-1][m] <= bound:
+                    row["missed"].add((len(ours) - 1, m))
                     misses.append(f"{scene}/{kind} {metric}: refined {ours[-1][m]:.3f} above "
                                   f"{'the paper' if floor[m] < paper[-1][m] else '1.5× the round trip'} {bound:.3f}")
+            rows.append(row)
+    return rows, misses
+
+
+def table1(c, summary):
+    """Table 1 as markdown, ours beside the paper's value in every cell and each scene's VAE round
+    trip as the floor (table1_rows). Returns (markdown lines, misses)."""
+    rows, misses = table1_rows(c, summary)
+    md = ["| scene | edit | " + " | ".join(lab for _, lab in TABLE1_COLUMNS) + " | VAE round trip |",
+          "|---|---|" + "---|" * (len(TABLE1_COLUMNS) + 1)]
+    for r in rows:
+        cells = [(f"{o[0]:.3f} / {o[1]:.3f}" if o else "–") + f" ({p[0]:.3f} / {p[1]:.3f})" for o, p in zip(r["ours"], r["paper"])]
+        md.append(f"| {r['label']} | {r['kind']} | " + " | ".join(cells) + f" | {r['floor'][0]:.3f} / {r['floor'][1]:.3f} |")
     return md, misses
+
+
+def table1_html(c, summary, title):
+    """Table 1 for report.html: a value that misses its target in red, the paper's in grey."""
+    rows, misses = table1_rows(c, summary)
+
+    def value(r, j, m):
+        v = f"{r['ours'][j][m]:.3f}" if r["ours"][j] else "–"
+        return f'<span class="miss">{v}</span>' if (j, m) in r["missed"] else v
+
+    h = [f"<h2>{html.escape(title)}</h2>", "<p>LPIPS / MSE×100, ours <span class='paper'>(paper's)</span>; "
+         f"<span class='miss'>red</span>: a target missed ({len(misses)}).</p>",
+         "<table class='t1'><tr><th>scene</th><th>edit</th>" + "".join(f"<th>{html.escape(lab)}</th>" for _, lab in TABLE1_COLUMNS) +
+         "<th>VAE round trip</th></tr>"]
+    for r in rows:
+        cells = "".join(f"<td>{value(r, j, 0)} / {value(r, j, 1)}<br><span class='paper'>({p[0]:.3f} / {p[1]:.3f})</span></td>"
+                        for j, p in enumerate(r["paper"]))
+        h.append(f"<tr><td>{html.escape(r['label'])}</td><td>{r['kind']}</td>{cells}"
+                 f"<td>{r['floor'][0]:.3f} / {r['floor'][1]:.3f}</td></tr>")
+    return h + ["</table>"]
 
 
 # --second-references (docs/metrics.md "Reference noise"): every scored frame's reference traced
 # again with this --ref-seed (render --edit of the eac fit into <scene>/noise_seed1/<kind>), then
-# scripts/reference_noise.py --ablation, for Table 1 against references with half the noise.
+# scripts/reference_noise.py --ablation, for Table 1 against an independent reference.
 NOISE_SEED = 1
 NOISE_DIR = f"noise_seed{NOISE_SEED}"
 
@@ -245,7 +278,8 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
             md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
                    t["equal_error"].rstrip(), "```"]
         md.append("")
-    if all(sc in PAPER_TABLE1 and set(s["edits"]) == set(KINDS) and "eac" in fits_of(c) for sc, s in summary.items()):
+    has_table1 = all(sc in PAPER_TABLE1 and set(s["edits"]) == set(KINDS) and "eac" in fits_of(c) for sc, s in summary.items())
+    if has_table1:
         t1, misses = table1(c, summary)
         md += ["## Table 1 layout: ours (paper's), LPIPS / MSE×100", "",
                "Mean over the evaluated frames; the paper's values (in brackets) are SD3.5's VAE and AlexNet LPIPS "
@@ -268,8 +302,14 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
     # Self-contained HTML report.
     h = ["<!doctype html><html><head><meta charset='utf-8'><title>latentpt experiments</title>",
          "<style>body{font-family:sans-serif;margin:2em;max-width:1200px} table{border-collapse:collapse} "
-         "td,th{border:1px solid #ccc;padding:3px 8px} img{image-rendering:pixelated}</style></head><body>",
+         "td,th{border:1px solid #ccc;padding:3px 8px} img{image-rendering:pixelated} .miss{color:#c00;font-weight:bold} "
+         ".paper{color:#888;font-size:90%} .t1 td{white-space:nowrap}</style></head><body>",
          "<h1>latentpt experiments</h1>", f"<p>{html.escape(md[2])}</p>"]
+    if has_table1:
+        h += table1_html(c, summary, "Table 1 layout (against the experiment's references)")
+    if noise and independent_table1_summary(noise):
+        h += table1_html(c, independent_table1_summary(noise), "Table 1 against an independent reference per frame "
+                         "(--second-references; MSE×100 less the reference's noise)")
     for scene, s in summary.items():
         h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
         for kind, table in s["edits"].items():
@@ -305,6 +345,14 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
 
 
 
+def independent_table1_summary(noise):
+    """table1()'s input against the independent references (NOISE_MEASURES "r2"), or None where a
+    scene is not the paper's or lacks an edit sequence."""
+    entries = {scene: noise_table1_entry(n, "r2") for scene, n in noise.items()}
+    ok = all(scene in PAPER_TABLE1 and set(e["edits"]) == set(KINDS) for scene, e in entries.items())
+    return entries if ok else None
+
+
 def independent_table1_lines(c, noise):
     """summary.md's section of Table 1 against the independent second reference of every scored
     frame: each scene's references' own variance, the table, its target misses."""
@@ -316,8 +364,8 @@ def independent_table1_lines(c, noise):
           "noise\"); the floor is the training reference's round trip scored the same way. σ²×100 of a reference "
           "(mean over the scored frames): " + ", ".join(f"{scene} {sum(v) / len(v):.4f}" for scene, v in sigma2.items()) +
           ". Against the mean of both references and against r₁: <scene>/" + NOISE_DIR + "/reference_noise.md.", ""]
-    entries = {scene: noise_table1_entry(n, "r2") for scene, n in noise.items()}
-    if not all(scene in PAPER_TABLE1 and set(e["edits"]) == set(KINDS) for scene, e in entries.items()):
+    entries = independent_table1_summary(noise)
+    if entries is None:
         return md + ["(no Table 1: it needs the three edit sequences of the paper's scenes)", ""]
     t1, misses = table1(c, entries)
     return md + t1 + ["", "Targets against these references: " + ("all met." if not misses else f"{len(misses)} missed:"), ""] + \

@@ -91,6 +91,17 @@ class Table1(unittest.TestCase):
         self.assertEqual(sorted(m.split(" ")[0] for m in misses if "1.5× the round trip" in m),
                          ["cbox-specular/light", "cbox-specular/object"])
 
+    def test_html_marks_the_missed_values(self):
+        c = X.settings(paper=True, scenes=["cbox-specular"])
+        bad = [(0.5, 2.0), (0.2, 0.3), (0.25, 0.2), (0.07, 0.02)]  # +Ĩc LPIPS; refined LPIPS on object, light
+        h = "\n".join(X.table1_html(c, self.summary(bad, (0.04, 0.01)), "t"))
+        _, misses = X.table1(c, self.summary(bad, (0.04, 0.01)))
+        self.assertEqual(len(misses), 5)
+        self.assertEqual(h.count('<span class="miss">'), len(misses))
+        self.assertEqual(h.count('<span class="miss">0.250</span>'), 3)
+        self.assertEqual(h.count('<span class="miss">0.070</span>'), 2)
+        self.assertIn("(0.502 / 2.264)", h)
+
     def test_a_missing_column_is_a_dash_and_skipped_by_the_ordering(self):
         c = X.settings(paper=True, scenes=["cbox-specular"])
         good = [(0.5, 2.0), (0.2, 0.3), (0.15, 0.2), (0.01, 0.02)]

@@ -151,6 +151,10 @@ def check_second_references(a, src, out):
     with open(os.path.join(out, "summary.md")) as f:
         summary = f.read()
     assert "## Table 1 against an independent reference per frame" in summary, summary
+    with open(os.path.join(out, "report.html")) as f:
+        report = f.read()
+    assert "<h2>Table 1 layout" in report and "<h2>Table 1 against an independent reference" in report, \
+        "report.html lacks the Table 1 tables"
     with open(os.path.join(out, "summary.json")) as f:
         assert json.load(f)["reference_noise"][SCENE] == result, "summary.json lacks the reference_noise result"
 
