@@ -26,7 +26,7 @@ mean (twice the spp). The VAE round trip gets the same treatment: dec(enc(r₁))
         --size 512 --ablation
 
 --ablation scores Table 1's four columns (the e and ea fits' frames, the eac fit's rendered and
-refined frames) and writes the experiment's Table 1 three times (experiment_lib.NOISE_MEASURES):
+refined frames) and writes the experiment's Table 1 three times (paper_table.NOISE_MEASURES):
 against r₁, as the experiment scores (its cells up to the PNGs' rounding), against r₂ (MSE less
 σ²), and against both (LPIPS vs r̄, noise-corrected MSE), with the targets' misses under each.
 
@@ -200,7 +200,7 @@ def round_trip_floor(a, m, refs_of, tmp):
 
 
 def table1_lines(a, result, measure):
-    """experiment_lib's Table 1 of these frames against the reference X.NOISE_MEASURES[measure]
+    """Table 1 (paper_table.py) of these frames against the reference X.NOISE_MEASURES[measure]
     names; against r₁ it reproduces the experiment's cells up to the PNGs' rounding."""
     scene = os.path.basename(os.path.normpath(a.scene_dir))
     if scene not in X.PAPER_TABLE1 or set(result["sequences"]) != set(X.KINDS):
