@@ -198,8 +198,9 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
          "<h1>latentpt experiments</h1>", f"<p>{html.escape(md[2])}</p>"]
     if has_table1:
         h += table1_html(c, summary, "Table 1 layout (against the experiment's references)")
-    if noise and independent_table1_summary(noise):
-        h += table1_html(c, independent_table1_summary(noise), "Table 1 against an independent reference per frame "
+    independent = independent_table1_summary(noise) if noise else None
+    if independent:
+        h += table1_html(c, independent, "Table 1 against an independent reference per frame "
                          "(--second-references; MSE×100 less the reference's noise)")
     for scene, s in summary.items():
         h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
