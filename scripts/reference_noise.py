@@ -54,11 +54,14 @@ class Scorer:
     run() (a process per pair spent ~1 s of its time loading libtorch and LPIPS)."""
 
     def __init__(self, binary, tmp):
-        self.binary, self.tmp, self.pairs = binary, tmp, []
+        self.binary, self.tmp, self.pairs, self.index = binary, tmp, [], {}
 
     def add(self, a, b):
-        self.pairs.append((a, b))
-        return len(self.pairs) - 1
+        """The pair's index in run()'s scores; a pair added again is scored once."""
+        if (a, b) not in self.index:
+            self.index[a, b] = len(self.pairs)
+            self.pairs.append((a, b))
+        return self.index[a, b]
 
     def run(self):
         listing = os.path.join(self.tmp, "pairs.txt")
@@ -154,14 +157,18 @@ def main():
             i = scorer.add(x, y)
             return lambda: scores[i]
 
-        def refs_of(seq, f):
+        converted = {}
+
+        def refs_of(seq, f):  # once per reference: frame 0, the training view, is in every sequence
             s1 = reference_stem(refs, seq, a.size, a.ref_spp, f)
-            s2 = reference_stem(refs, seq, a.size, a.ref_spp, f, f"_seed{a.seed}")
-            r1, r2, rbar = (os.path.join(tmp, f"{seq}_{f}_{k}.png") for k in ("r1", "r2", "mean"))
-            for exr, png in ((s1 + ".exr", r1), (s2 + ".exr", r2)):
-                display_png(exr, png)
-            mean_png(r1, r2, rbar)
-            return s1, r1, r2, rbar, m(r1, r2)
+            if s1 not in converted:
+                s2 = reference_stem(refs, seq, a.size, a.ref_spp, f, f"_seed{a.seed}")
+                r1, r2, rbar = (os.path.join(tmp, f"{seq}_{f}_{k}.png") for k in ("r1", "r2", "mean"))
+                for exr, png in ((s1 + ".exr", r1), (s2 + ".exr", r2)):
+                    display_png(exr, png)
+                mean_png(r1, r2, rbar)
+                converted[s1] = (s1, r1, r2, rbar, m(r1, r2))
+            return converted[s1]
 
         columns_by_seq = {seq: columns_of(a, a.scene_dir, seq, frames) for seq in a.sequences.split(",")}
         for seq, f in [(seq, f) for seq in columns_by_seq for f in frames] + [("training", 0)]:
@@ -178,7 +185,7 @@ def main():
                 # this frame's own VAE round trip, dec(enc(r₁)), scored as the columns are
                 row_of["vae_roundtrip"] = frame_row(m, round_trip_png(a, s1, tmp, decoded), r1, r2, rbar, r12)
                 pending[seq, f] = (r12, row_of)
-        floor = round_trip_floor(a, m, refs_of, tmp)
+        floor = round_trip_floor(a, m, refs_of, tmp, decoded)
         scores += scorer.run()
     result = {"sequences": {}, "floor": floor()}
     for (seq, f), (r12, row_of) in pending.items():
@@ -198,14 +205,14 @@ def round_trip_png(a, stem, tmp, decoded):
     return decoded[stem]
 
 
-def round_trip_floor(a, m, refs_of, tmp):
+def round_trip_floor(a, m, refs_of, tmp, decoded):
     """The VAE round trip of the training view: dec(enc(r₁)) against r₂ less σ² is its distance
     from the converged view; against r₁ it is what the table calls the floor. LPIPS has no
     correction: dec(enc(r̄)) against r̄ is the round trip at twice the spp, the floor of the
     LPIPS-against-r̄ columns. Returns a function giving it once the pairs are scored."""
     s1, r1, r2, rbar, r12 = refs_of("training", 0)
-    rt, rt_mean, latent_mean = (os.path.join(tmp, n) for n in ("roundtrip.png", "roundtrip_mean.png", "mean.exr"))
-    subprocess.run([a.bin, "decode", s1 + "_latent.exr", "-o", rt, "-q"], check=True)
+    rt = round_trip_png(a, s1, tmp, decoded)
+    rt_mean, latent_mean = (os.path.join(tmp, n) for n in ("roundtrip_mean.png", "mean.exr"))
     subprocess.run([a.bin, "encode", rbar, "-o", latent_mean, "-q"], check=True)
     subprocess.run([a.bin, "decode", latent_mean, "-o", rt_mean, "-q"], check=True)
     f1, f2, fm = m(rt, r1), m(rt, r2), m(rt_mean, rbar)
@@ -223,6 +230,9 @@ def table1_lines(a, result, measure):
     return X.table1({"scene_res": {scene: a.size}, "image_res": a.size}, {scene: X.noise_table1_entry(result, measure)})
 
 
+mse_r2_less_sigma2 = X.NOISE_MEASURES["r2"][1]  # a row's column against r₂, less σ²
+
+
 def write_report(out, a, result):
     lines = [f"# Reference noise on {a.scene_dir} ({a.ref_spp}-spp references, seeds 0x5eed and {a.seed})",
              "",
@@ -235,7 +245,7 @@ def write_report(out, a, result):
         s2 = mean(rows, "sigma2_x100")
         for kind in (k for k in rows[0] if k not in ("frame", "sigma2_x100")):
             k = [r[kind] for r in rows]
-            r2 = sum(r[kind]["mse_r2"] - r["sigma2_x100"] for r in rows) / len(rows)
+            r2 = sum(mse_r2_less_sigma2(r, r[kind]) for r in rows) / len(rows)
             lines.append(f"| {seq} | {kind} | {mean(k, 'mse_r1'):.4f} | {r2:.4f} | {mean(k, 'mse_corrected'):.4f} | {s2:.4f} | "
                          f"{mean(k, 'lpips_r1'):.4f} | {mean(k, 'lpips_r2'):.4f} | {mean(k, 'lpips_mean_ref'):.4f} |")
     fl = result["floor"]

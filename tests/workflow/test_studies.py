@@ -144,7 +144,7 @@ def check_second_references(a, src, out):
                     f"{kind}/{col} frame {row['frame']} against r1: {ours} against the experiment's {theirs}"
                 law = 0.5 * (ours["mse_r1"] + ours["mse_r2"]) - 0.5 * row["sigma2_x100"]
                 assert close(ours["mse_mean_ref"], law, 1e-2), f"{kind}/{col}: parallelogram law {ours} against {law}"
-        # frame 0's own round trip is the training view's, the floor: the same decode against the same r₁
+        # frame 0's own round trip is the training view's: the floor
         assert close(rows[0]["vae_roundtrip"]["mse_r1"], result["floor"]["mse_r1"], 1e-9), (rows[0], result["floor"])
     with open(os.path.join(scene_dir, "noise_seed1", "reference_noise.md")) as f:
         md = f.read()
