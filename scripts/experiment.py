@@ -70,14 +70,16 @@ def snakemake_command(a, config_path, out):
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
-def run_workflow(cmd):
+def run_workflow(cmd, lock):
     """Run Snakemake in a process group of its own and return (its exit status, the stop signal
     received or None). A SIGINT, SIGTERM or SIGHUP to this process reaches the whole group as the
     SIGINT of a terminal's Ctrl-C: running jobs stop where they are (killed jobs resume on the next
     run) and Snakemake cancels its Slurm jobs. Snakemake alone would finish its running jobs first,
     and a parent that exits at once (Python's SIGTERM) would free the folder's lock with Snakemake
     still running, so this process waits for the group with the lock held. A second signal kills
-    the group."""
+    the group. Snakemake holds the lock too (an flock belongs to the open file, which it inherits):
+    a SIGKILL to this process alone leaves Snakemake running, and a run started beside it would
+    race it for the same files."""
     received, group = [], []
 
     def forward(signum, _frame):
@@ -97,7 +99,7 @@ def run_workflow(cmd):
         # A process group, not a session: a new session is also a new scheduler autogroup on
         # Linux. With one, experiment.quick beside four other tests (ctest -j2) took 336 s, with
         # the group 178 s (one run each, 2 cores; CI with a session: 680-725 s).
-        p = subprocess.Popen(cmd, process_group=0)
+        p = subprocess.Popen(cmd, process_group=0, pass_fds=(lock.fileno(),))
         group.append(p.pid)
         if received:  # arrived before the group existed
             stop(signal.SIGINT)
@@ -160,14 +162,15 @@ def main():
         sys.exit(f"experiment: {c['bin']} not found (bash scripts/build.sh)")
     os.makedirs(c["out"], exist_ok=True)
     lock = open(os.path.join(c["out"], ".experiment.lock"), "w")
-    try:  # released by the kernel however this process ends, unlike Snakemake's lock folder
+    try:  # released by the kernel once this process and its Snakemake end, however, unlike Snakemake's lock folder
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
-        sys.exit(f"experiment: {c['out']} is in use by another experiment run")
+        sys.exit(f"experiment: {c['out']} is in use by another experiment run (or by the Snakemake of one whose "
+                 "experiment.py was killed; it goes on to the end)")
     config_path = os.path.join(c["out"], "experiment-config.json")
     X.write_atomic(config_path, json.dumps(c, indent=1))
     started = time.time()
-    returncode, stopped_by = run_workflow(snakemake_command(a, config_path, c["out"]))
+    returncode, stopped_by = run_workflow(snakemake_command(a, config_path, c["out"]), lock)
     if stopped_by is not None:
         print(f"experiment: stopped by {signal.Signals(stopped_by).name}; finished jobs are kept in {c['out']}: "
               "run again with the same flags to continue", file=sys.stderr)

@@ -2,57 +2,27 @@
 """A SIGTERM or SIGINT sent to scripts/experiment.py alone (a batch system's cancel, `kill`,
 `timeout`) stops the whole run before experiment.py exits: no job or Snakemake process of it
 is left running beside a run started next, and the folder's lock is free. experiment.py exits
-with 128 + the signal and says how to continue. The latentpt jobs are a stand-in script that
+with 128 + the signal and says how to continue. A SIGKILL to experiment.py alone leaves the folder
+locked while its Snakemake goes on. The latentpt jobs are a stand-in script that
 records its pid and sleeps, so the test costs no CPU (~5 s).
 
     tests/workflow/test_interrupt.py
 Exit 77 (skipped) without snakemake or ../shared."""
-import fcntl
 import os
 import shutil
 import signal
 import subprocess
 import sys
 import tempfile
-import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from processes import alive, group_members, kill_groups, lock_is_free, wait_until  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FAKE_BINARY = """#!/bin/sh
 echo $$ >> "$LPT_FAKE_PIDS"
 exec sleep 300
 """
-
-
-def process_state(pid):
-    """(state letter, process group) of a process from /proc/<pid>/stat, or None once it is gone."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            fields = f.read().rsplit(")", 1)[1].split()
-    except (FileNotFoundError, ProcessLookupError):
-        return None
-    return fields[0], int(fields[2])
-
-
-def alive(pid):
-    """True while pid runs (a zombie has finished)."""
-    state = process_state(pid)
-    return state is not None and state[0] != "Z"
-
-
-def group_members(pgid):
-    """Running (not zombie) processes of process group pgid. kill(-pgid, 0) would count a
-    zombie that init has not reaped yet."""
-    states = {int(e): process_state(e) for e in os.listdir("/proc") if e.isdigit()}
-    return [pid for pid, st in states.items() if st and st[0] != "Z" and st[1] == pgid]
-
-
-def wait_until(condition, seconds):
-    end = time.time() + seconds
-    while time.time() < end:
-        if condition():
-            return True
-        time.sleep(0.05)
-    return condition()
 
 
 def job_pids(path):
@@ -62,49 +32,98 @@ def job_pids(path):
         return [int(line) for line in f if line.strip()]
 
 
+class Run:
+    """One experiment.py run in a session of its own, its jobs the stand-in script."""
+
+    def __init__(self, tmp, binary, name):
+        self.out, self.pids, self.log = (os.path.join(tmp, name + suffix) for suffix in ("", ".pids", ".stderr"))
+        self.env = dict(os.environ, LPT_FAKE_PIDS=self.pids)
+        self.cmd = [sys.executable, os.path.join(ROOT, "scripts", "experiment.py"), "--quick", "--bin", binary,
+                    "--out", self.out]
+        with open(self.log, "w") as err:  # a file, not a pipe: a surviving Snakemake would hold a pipe open
+            self.p = subprocess.Popen(self.cmd, env=self.env, stdout=subprocess.DEVNULL, stderr=err,
+                                      start_new_session=True)
+        self.groups = {self.p.pid}
+
+    def wait_for_first_job(self):
+        """The pids of the jobs running once the first has started, or None if experiment.py
+        skipped (77)."""
+        p = self.p
+        if not wait_until(lambda: job_pids(self.pids) or p.poll() is not None, 120):
+            raise AssertionError("no job started within 120 s")
+        if p.poll() is not None:
+            if p.returncode == 77:
+                return None
+            raise AssertionError(f"experiment.py ended before its first job ({p.returncode})")
+        jobs = job_pids(self.pids)
+        self.groups |= {os.getpgid(j) for j in jobs}
+        return jobs
+
+    def lock_is_free(self):
+        return lock_is_free(self.out)
+
+    def stderr(self):
+        with open(self.log) as f:
+            return f.read()
+
+    def kill(self):
+        """Leave nothing behind, also when a check fails."""
+        kill_groups(self.groups)
+        self.p.poll()
+
+
 def stop_mid_job(tmp, binary, sig):
     """Start the experiment, wait for its first job, send `sig` to experiment.py alone, check
     that nothing of the run outlives it. Returns None, or 77 to skip."""
     name = signal.Signals(sig).name
-    out, pids, log = (os.path.join(tmp, name + suffix) for suffix in ("", ".pids", ".stderr"))
-    env = dict(os.environ, LPT_FAKE_PIDS=pids)
-    cmd = [sys.executable, os.path.join(ROOT, "scripts", "experiment.py"), "--quick", "--bin", binary, "--out", out]
-    with open(log, "w") as err:  # a file, not a pipe: a surviving Snakemake would hold a pipe open
-        p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=err, start_new_session=True)
-    groups = {p.pid}
+    run = Run(tmp, binary, name)
+    p = run.p
     try:
-        if not wait_until(lambda: job_pids(pids) or p.poll() is not None, 120):
-            raise AssertionError("no job started within 120 s")
-        if p.poll() is not None:
-            if p.returncode == 77:
-                return 77
-            raise AssertionError(f"experiment.py ended before its first job ({p.returncode})")
-        jobs = job_pids(pids)
-        groups |= {os.getpgid(j) for j in jobs}
+        jobs = run.wait_for_first_job()
+        if jobs is None:
+            return 77
         os.kill(p.pid, sig)
         try:
             p.wait(timeout=60)
         except subprocess.TimeoutExpired:
             raise AssertionError(f"{name}: experiment.py still running 60 s after the signal")
         # Processes of the group that Snakemake did not wait for may take a moment to go.
+        groups = run.groups
         wait_until(lambda: not any(alive(j) for j in jobs) and not any(group_members(g) for g in groups), 10)
         left = [j for j in jobs if alive(j)] + [f"group {g}: {group_members(g)}" for g in groups if group_members(g)]
     finally:
-        for g in groups:  # leave nothing behind when a check fails
-            try:
-                os.killpg(g, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-        p.poll()
-    with open(log) as f:
-        err = f.read()
+        run.kill()
+    err = run.stderr()
     assert not left, f"{name}: the run outlived experiment.py: {left}"
     assert p.returncode == 128 + sig, f"{name}: exit {p.returncode}, expected {128 + sig}; stderr: {err}"
     assert "run again" in err, f"{name}: no word on how to continue: {err}"
-    with open(os.path.join(out, ".experiment.lock"), "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)  # raises if something still holds it
+    assert run.lock_is_free(), f"{name}: the folder is still locked"
     print(f"test_interrupt: {name} stopped {len(jobs)} job(s) and Snakemake before experiment.py exited "
           f"({p.returncode})")
+    return None
+
+
+def kill_alone(tmp, binary):
+    """A SIGKILL to experiment.py alone (`kill -9`, an OOM kill) cannot reach its Snakemake, which
+    goes on: the folder stays locked while it runs, so a second run is refused rather than racing
+    it for the same files, and the lock is free once Snakemake has gone. Returns None, or 77."""
+    run = Run(tmp, binary, "SIGKILL")
+    try:
+        if run.wait_for_first_job() is None:
+            return 77
+        os.kill(run.p.pid, signal.SIGKILL)
+        run.p.wait()
+        assert not run.lock_is_free(), "SIGKILL: the lock was freed with the run's Snakemake still running"
+        second = subprocess.run(run.cmd, env=run.env, capture_output=True, text=True, timeout=120)
+        assert second.returncode not in (0, 77) and "in use" in second.stderr, \
+            f"SIGKILL: a second run beside the orphaned Snakemake was not refused ({second.returncode}): {second.stderr}"
+    finally:
+        run.kill()
+    groups = run.groups
+    wait_until(lambda: not any(group_members(g) for g in groups), 10)
+    assert run.lock_is_free(), "SIGKILL: the folder is still locked after the run's processes were killed"
+    print("test_interrupt: SIGKILL to experiment.py alone: the folder stayed locked until its Snakemake was gone; "
+          "a second run was refused")
     return None
 
 
@@ -120,6 +139,8 @@ def main():
         for sig in (signal.SIGTERM, signal.SIGINT):
             if stop_mid_job(tmp, binary, sig) == 77:
                 return 77
+        if kill_alone(tmp, binary) == 77:
+            return 77
     return 0
 
 
