@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The experiment workflow killed mid-way (SIGKILL to the whole process group, as a crash would)
+"""The experiment workflow killed mid-way (SIGKILL to every process of it, as a crash would)
 resumes without recomputing any finished fit or frame, and gives the summary.json of a run that
 was never stopped (issue 20). Tiny settings: ~2 x 1 minute on 2 cores.
 
@@ -9,10 +9,12 @@ import argparse
 import glob
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from processes import group_members, groups_below, kill_groups, lock_is_free, wait_until  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TINY = ["--quick", "--image-res", "64", "--frames", "4", "--chunk", "2", "--fit-iterations", "30",
@@ -49,8 +51,13 @@ def main():
     # Kill once the first edit chunk has finished one frame but not its sequence.
     while p.poll() is None and not glob.glob(os.path.join(killed, "*", "camera_eac", "frame_0000.done")):
         time.sleep(0.05)
-    os.killpg(p.pid, signal.SIGKILL)
+    # experiment.py's group and its Snakemake's (a group of its own, with the jobs): killing the
+    # first alone would leave Snakemake running beside the resumed run.
+    groups = groups_below(p.pid)
+    kill_groups(groups)
     p.wait()
+    assert wait_until(lambda: not any(group_members(g) for g in groups) and lock_is_free(killed), 30), \
+        "the killed run's processes live on"
     before = finished_marks(killed)
     frames_before = [f for f in before if f.endswith("frame_0000.done")]
     assert frames_before, "the run ended before the kill; nothing was tested"
