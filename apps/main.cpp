@@ -106,6 +106,13 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
           "(also the camera rolled by quarter turns); each against its reference moved the same way and encoded")
         ->check(CLI::IsMember({"none", "mirror", "dihedral"}))
         ->default_str(pipeline::to_string(ra.augment));
+    sc->add_option_function<std::string>(
+          "--" + pre + "latent-target", [&ra](const std::string& v) { ra.compensated_target = v == "compensated"; },
+          "what the refiner learns to output: encoded (the reference's encoding, target.exr; the paper's) or "
+          "compensated (the reference encoded with the decoder's colour bias over each latent cell added back, "
+          "so that it decodes closer to the reference)")
+        ->check(CLI::IsMember({"encoded", "compensated"}))
+        ->default_str(ra.compensated_target ? "compensated" : "encoded");
     add_number(sc, "--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints",
                non_negative());
     sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");

@@ -9,6 +9,7 @@
 #include "pipeline/paths.h"
 #include "pipeline/refiner_augment.h"
 #include "pipeline/refiner_io.h"
+#include "vae/compensated_encode.h"
 #include "vae/lpips.h"
 #include "vae/vae.h"
 #include <algorithm>
@@ -97,7 +98,8 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
         {"augment", to_string(job.augment)},
         {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
         {"inference_window", refiner.config().tile},
-        {"lpips_crop", job.train.lpips_crop}};
+        {"lpips_crop", job.train.lpips_crop},
+        {"latent_target", job.compensated_target ? "compensated" : "encoded"}};
     if (refiner.config().arch != RefinerArch::Conv) record["arch"] = to_string(refiner.config().arch);
     if (refiner.config().terms) record["inputs"] = "terms";
     return record;
@@ -147,28 +149,47 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit
     return views;
 }
 
-/// The training examples: every noise view against the target, then (job.augment) every noise
+/// Throws unless the fit has a path-traced reference and a VAE, which `option` needs.
+void require_reference(const RefineJob& job, const Judges& judges, const std::string& option) {
+    if (!judges.path_traced || !judges.vae)
+        throw std::runtime_error((fs::path(job.fitdir) / "reference_rgb.exr").string() + ": " + option +
+                                 " needs the fit's path-traced reference and its VAE " +
+                                 (judges.path_traced ? "(no VAE found)" : "(missing: fit with --encode)"));
+}
+
+/// The latent a training view's reference `rgb` is learnt as: its encoding, or with
+/// job.compensated_target its compensated encoding.
+std::vector<float> latent_target(const RefineJob& job, const Vae& vae, const std::vector<float>& rgb, int width,
+                                 int height) {
+    return job.compensated_target ? encode_compensated(vae, rgb, width, height) : vae.encode(rgb, width, height);
+}
+
+/// The training examples: every noise view against the target (target.exr, or with
+/// job.compensated_target the reference's compensated encoding), then (job.augment) every noise
 /// view moved by each other transform, against the reference image moved the same way and
 /// encoded again (docs/refiner.md "Augmentation").
 std::vector<RefinerExample> training_examples(const RefineJob& job, const FitFolder& fit,
                                               const std::vector<RefinerInput>& views, const Image& target,
                                               const Judges& judges, const Reporter& report) {
+    const int iw = 8 * target.width, ih = 8 * target.height;
+    std::vector<float> view_target = target.data;
+    if (job.compensated_target) {
+        require_reference(job, judges, "refine --latent-target compensated (fit --refiner-latent-target)");
+        report.say("[refine] target: the reference encoded with the decoder's low-frequency bias compensated");
+        view_target = latent_target(job, *judges.vae, judges.ref_rgb, iw, ih);
+    }
     std::vector<RefinerExample> examples;
-    for (const RefinerInput& v : views) examples.push_back({v, target.data, judges.ref_rgb});
+    for (const RefinerInput& v : views) examples.push_back({v, view_target, judges.ref_rgb});
     const std::vector<ViewTransform> moves = augment_transforms(job.augment);
     if (moves.size() == 1) return examples;
-    if (!judges.path_traced || !judges.vae)
-        throw std::runtime_error((fs::path(job.fitdir) / "reference_rgb.exr").string() + ": --refiner-augment " +
-                                 to_string(job.augment) + " needs the fit's path-traced reference and its VAE " +
-                                 (judges.path_traced ? "(no VAE found)" : "(missing: fit with --encode)"));
+    require_reference(job, judges, "--refiner-augment " + to_string(job.augment));
     report.say("[refine] " + std::to_string(moves.size() - 1) + " augmented views (" + to_string(job.augment) +
                "): encoding their references");
     const Vec3f right = mirror_plane_normal(fit.scene->camera);
-    const int iw = 8 * target.width, ih = 8 * target.height;
     for (size_t m = 1; m < moves.size(); ++m) {
         std::vector<float> rgb = transform_image(judges.ref_rgb, iw, ih, 3, moves[m]);
         const bool swap = moves[m].swaps_axes();
-        std::vector<float> moved_target = judges.vae->encode(rgb, swap ? ih : iw, swap ? iw : ih);
+        std::vector<float> moved_target = latent_target(job, *judges.vae, rgb, swap ? ih : iw, swap ? iw : ih);
         for (const RefinerInput& v : views) examples.push_back({transform_view(v, moves[m], right), moved_target, rgb});
     }
     return examples;

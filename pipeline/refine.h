@@ -23,6 +23,10 @@ struct RefineJob {
     /// Mirrored and rolled copies of the training view, each against its reference moved the same
     /// way and encoded again (needs reference_rgb.exr; docs/refiner.md "Augmentation").
     RefinerAugment augment = RefinerAugment::None;
+    /// Train towards each view's reference encoded with the decoder's low-frequency bias
+    /// compensated (vae/compensated_encode.h) instead of its plain encoding, target.exr; needs
+    /// reference_rgb.exr (docs/refiner.md "Latent target").
+    bool compensated_target = false;
     /// Apply the trained refiner on windows the size of its training crop (RefinerConfig::tile)
     /// when InstanceNorm is on and the crop is smaller than the view; false: the whole view at once.
     bool windowed_inference = true;

@@ -135,6 +135,9 @@ def main():
                     help="every fit's --emission-decay (default: the preset's, else 0; docs/fitting.md (17))")
     ap.add_argument("--emitter-response-decay", type=float, default=None,
                     help="every fit's --emitter-response-decay (default: the preset's, else 0; docs/fitting.md (18))")
+    ap.add_argument("--refiner-latent-target", choices=["encoded", "compensated"], default=None,
+                    help="the eac fit's refiner target (default: the preset's, else encoded; docs/refiner.md "
+                         "\"Latent target\")")
     ap.add_argument("--second-references", action="store_true",
                     help="also trace every scored frame's reference again with another seed and add Table 1 against "
                          "these independent references (MSE less their noise) to the summary; costs about the edit "
@@ -151,7 +154,8 @@ def main():
                    shared=a.shared, image_res=a.image_res, frames=a.frames, ref_spp=a.ref_spp,
                    fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk,
                    paper=a.paper, frame_step=a.frame_step, emission_decay=a.emission_decay, param=a.param,
-                   emitter_response_decay=a.emitter_response_decay, second_references=a.second_references)
+                   emitter_response_decay=a.emitter_response_decay, second_references=a.second_references,
+                   refiner_latent_target=a.refiner_latent_target)
     for s in c["scenes"]:
         if s not in X.SCENES:
             sys.exit(f"experiment: unknown scene '{s}' (have {', '.join(X.SCENES)})")

@@ -128,7 +128,8 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
     md = ["# latentpt experiment summary", "",
           f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
           "reference spp per scene below, "
-          f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}), "
+          f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}"
+          f"{', latent target ' + c['refiner_latent_target'] if c.get('refiner_latent_target', 'encoded') != 'encoded' else ''}), "
           f"parameterisation {c.get('param', 'code')}, emission decay {c.get('emission_decay', 0):g}, "
           f"emitter response decay {c.get('emitter_response_decay', 0):g}, frames {frames or 'as in the edit files'}"
           f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp", ""]
@@ -277,7 +278,8 @@ PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
              fit_iterations=None, refiner_iterations=None, spp=64, chunk=8, paper=False, frame_step=None,
-             emission_decay=None, emitter_response_decay=None, param=None, second_references=False):
+             emission_decay=None, emitter_response_decay=None, param=None, second_references=False,
+             refiner_latent_target=None):
     """The workflow's config (JSON-able): --quick's small sizes, --paper's preset or the full run's;
     flags given explicitly win over the preset's values."""
     p = PAPER if paper else {}
@@ -289,7 +291,9 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "scene_res": {} if image_res else p.get("scene_res", {}),
             "fit_iterations": fit_iterations or p.get("fit_iterations") or (300 if quick else 1500),
             "refiner_iterations": refiner_iterations or p.get("refiner_iterations") or (300 if quick else 3000),
-            "refiner_lr_decay": p.get("refiner_lr_decay", "none"), "emission_decay": p.get("emission_decay", 0) if emission_decay is None else emission_decay,
+            "refiner_lr_decay": p.get("refiner_lr_decay", "none"),
+            "refiner_latent_target": refiner_latent_target or p.get("refiner_latent_target", "encoded"),
+            "emission_decay": p.get("emission_decay", 0) if emission_decay is None else emission_decay,
             "emitter_response_decay": p.get("emitter_response_decay", 0) if emitter_response_decay is None else emitter_response_decay,
             "param": p.get("param", "code") if param is None else param,
             "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
@@ -383,6 +387,8 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
     # option, which have no key) stay as they were
     if refine and c.get("refiner_lr_decay", "none") != "none":
         cmd += ["--refiner-lr-decay", c["refiner_lr_decay"]]
+    if refine and c.get("refiner_latent_target", "encoded") != "encoded":
+        cmd += ["--refiner-latent-target", c["refiner_latent_target"]]
     if decay and c.get("emission_decay", 0):
         cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     if decay and c.get("emitter_response_decay", 0):

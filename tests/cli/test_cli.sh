@@ -137,6 +137,13 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" refine "$out/enc_aug" --iterations 6 --expansion 1 -q --augment dihedral
     check grep -q '"augment": "dihedral"' "$out/enc_aug/metrics.json"
     expect_error "augment" "$bin" refine "$out/enc_aug" -q --augment flip
+    # The compensated latent target: trained, recorded; refused without the fit's RGB reference.
+    cp -r "$out/enc" "$out/enc_comp"
+    "$bin" refine "$out/enc_comp" --iterations 6 --expansion 1 -q --latent-target compensated
+    check grep -q '"latent_target": "compensated"' "$out/enc_comp/metrics.json"
+    expect_error "latent-target" "$bin" refine "$out/enc_comp" -q --latent-target decoded
+    rm "$out/enc_comp/reference_rgb.exr"
+    expect_error "reference_rgb.exr: refine --latent-target compensated" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target compensated
     # Fits sharing a training reference through --reference-cache: traced once, the same target
     # as a fit that traces its own.
     for d in encc1 encc2; do

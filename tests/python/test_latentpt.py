@@ -312,7 +312,8 @@ class OneProcessTest(unittest.TestCase):
                 latentpt.refine(fit, crops=4)
             for bad, name in (({"dropout": 1.5}, "dropout"), ({"lr_decay": "linear"}, "lr_decay"),
                               ({"iterations": 0}, "iterations"), ({"augment": "turn"}, "turn"),
-                              ({"arch": "mlp"}, "arch"), ({"inputs": "rgb"}, "inputs")):
+                              ({"arch": "mlp"}, "arch"), ({"inputs": "rgb"}, "inputs"),
+                              ({"latent_target": "decoded"}, "latent_target")):
                 with self.assertRaises(ValueError) as e:
                     latentpt.refine(fit, note=lambda t: None, **bad)
                 self.assertIn(name, str(e.exception))

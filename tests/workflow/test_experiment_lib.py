@@ -56,6 +56,15 @@ class Preset(unittest.TestCase):
         self.assertEqual((c["frame_step"], c["fit_iterations"]), (2, 10))
         self.assertEqual(X.settings()["fits"], list(X.FITS))
 
+    def test_latent_target_only_on_the_refined_fit_and_only_when_compensated(self):
+        c = X.settings(paper=True, refiner_latent_target="compensated")
+        self.assertIn("--refiner-latent-target compensated", X.fit_command(c, "cbox-specular", "eac", 2))
+        self.assertNotIn("--refiner-latent-target", X.fit_command(c, "cbox-specular", "ea", 2))  # no refiner
+        self.assertNotIn("--refiner-latent-target", X.training_reference_command(c, "cbox-specular", 2))
+        # the default names nothing: commands, and so cached jobs, stay as they were
+        self.assertNotIn("--refiner-latent-target", X.fit_command(X.settings(paper=True), "cbox-specular", "eac", 2))
+        self.assertEqual(X.settings(paper=True)["refiner_latent_target"], "encoded")
+
     def test_training_reference_is_a_one_iteration_fit_into_refs(self):
         cmd = X.training_reference_command(X.settings(paper=True), "cbox-specular", 2)
         for part in ("--iterations 1 ", "--reference-cache cbox-specular/refs", "--no-refiner", "--encode-res 1024x1024"):
