@@ -51,6 +51,15 @@ void add_number(CLI::App* sc, const std::string& name, T& value, const std::stri
     sc->add_option(name, value, help)->capture_default_str()->check(check);
 }
 
+/// A choice of two words kept as a bool: true when given `yes`; --help lists them in the order given.
+void add_choice(CLI::App* sc, const std::string& name, bool& flag, const std::string& yes, const std::string& no,
+                const std::string& help, bool yes_first = false) {
+    sc->add_option_function<std::string>(
+          name, [&flag, yes](const std::string& v) { flag = v == yes; }, help)
+        ->check(CLI::IsMember(yes_first ? std::vector<std::string>{yes, no} : std::vector<std::string>{no, yes}))
+        ->default_str(flag ? yes : no);
+}
+
 /// Stage-2 options: `--refiner-<name>` on fit, `--<name>` on refine.
 void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string& pre) {
     add_number(sc, "--" + pre + "iterations", ra.train.iterations, "refiner training steps", positive());
@@ -60,22 +69,16 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
     add_number(sc, "--" + pre + "lpips-crop", ra.train.lpips_crop,
                "latent side of the sub-crop decoded for LPIPS (0 = no LPIPS)", non_negative());
     add_number(sc, "--" + pre + "lr", ra.train.lr, "refiner Adam learning rate", positive());
-    sc->add_option_function<std::string>(
-          "--" + pre + "lr-decay", [&ra](const std::string& v) { ra.train.cosine_decay = v == "cosine"; },
-          "refiner learning rate over the steps: none (constant) or cosine (one half cosine down to 0)")
-        ->check(CLI::IsMember({"none", "cosine"}))
-        ->default_str(ra.train.cosine_decay ? "cosine" : "none");
+    add_choice(sc, "--" + pre + "lr-decay", ra.train.cosine_decay, "cosine", "none",
+               "refiner learning rate over the steps: none (constant) or cosine (one half cosine down to 0)");
     add_number(sc, "--" + pre + "patience", ra.train.patience, "refiner early stopping on the smoothed loss; 0 = off",
                non_negative());
     add_number(sc, "--" + pre + "w-mse", ra.train.w_mse, "weight of latent MSE", non_negative());
     add_number(sc, "--" + pre + "w-ssim", ra.train.w_ssim, "weight of latent 1 - SSIM", non_negative());
     add_number(sc, "--" + pre + "w-lpips", ra.train.w_lpips, "weight of LPIPS on decoded crops", non_negative());
     add_number(sc, "--" + pre + "squash", ra.net.squash, "inputs enter as tanh(x / squash)", positive());
-    sc->add_option_function<std::string>(
-          "--" + pre + "norm", [&ra](const std::string& v) { ra.net.instance_norm = v == "instance"; },
-          "normalisation after each convolution: instance (ours) or none (the paper's network)")
-        ->check(CLI::IsMember({"instance", "none"}))
-        ->default_str(ra.net.instance_norm ? "instance" : "none");
+    add_choice(sc, "--" + pre + "norm", ra.net.instance_norm, "instance", "none",
+               "normalisation after each convolution: instance (ours) or none (the paper's network)", true);
     sc->add_option_function<std::string>(
           "--" + pre + "arch",
           [&ra, pre](const std::string& v) { ra.net.arch = parse_refiner_arch(v, "--" + pre + "arch"); },
@@ -83,36 +86,26 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
           "U-Net with skip connections, a wider view at a fifth of the cost per pixel)")
         ->check(CLI::IsMember({"conv", "unet"}))
         ->default_str(to_string(ra.net.arch));
-    sc->add_option_function<std::string>(
-          "--" + pre + "inputs", [&ra](const std::string& v) { ra.net.terms = v == "terms"; },
-          "what the refiner reads besides the AOVs: latent (the toned render) or terms (also its transport terms "
-          "Ie, Ia, Ic before the tone curve; edits then render them too)")
-        ->check(CLI::IsMember({"latent", "terms"}))
-        ->default_str(ra.net.terms ? "terms" : "latent");
-    sc->add_option_function<std::string>(
-          "--" + pre + "inference", [&ra](const std::string& v) { ra.windowed_inference = v == "windows"; },
-          "how the trained refiner is applied: windows (the training crop's size, stride half of it, averaged; "
-          "InstanceNorm then sees what it saw in training) or whole (the whole view at once)")
-        ->check(CLI::IsMember({"windows", "whole"}))
-        ->default_str(ra.windowed_inference ? "windows" : "whole");
+    add_choice(sc, "--" + pre + "inputs", ra.net.terms, "terms", "latent",
+               "what the refiner reads besides the AOVs: latent (the toned render) or terms (also its transport terms "
+               "Ie, Ia, Ic before the tone curve; edits then render them too)");
+    add_choice(sc, "--" + pre + "inference", ra.windowed_inference, "windows", "whole",
+               "how the trained refiner is applied: windows (the training crop's size, stride half of it, averaged; "
+               "InstanceNorm then sees what it saw in training) or whole (the whole view at once)",
+               true);
     add_number(sc, "--" + pre + "dropout", ra.net.dropout, "dropout after each block", CLI::Range(0.0, 0.99));
-    sc->add_option("--" + pre + "noise-views", ra.noise_views,
-                   "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone")
-        ->capture_default_str()
-        ->check(positive());
+    add_number(sc, "--" + pre + "noise-views", ra.noise_views,
+               "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone",
+               positive());
     sc->add_option_function<std::string>(
           "--" + pre + "augment", [&ra](const std::string& v) { ra.augment = pipeline::parse_refiner_augment(v); },
           "extra training views made from the training view alone: none, mirror (its mirror image) or dihedral "
           "(also the camera rolled by quarter turns); each against its reference moved the same way and encoded")
         ->check(CLI::IsMember({"none", "mirror", "dihedral"}))
         ->default_str(pipeline::to_string(ra.augment));
-    sc->add_option_function<std::string>(
-          "--" + pre + "latent-target", [&ra](const std::string& v) { ra.compensated_target = v == "compensated"; },
-          "what the refiner learns to output: encoded (the reference's encoding, target.exr; the paper's) or "
-          "compensated (the reference encoded with the decoder's colour bias over each latent cell added back, "
-          "so that it decodes closer to the reference)")
-        ->check(CLI::IsMember({"encoded", "compensated"}))
-        ->default_str(ra.compensated_target ? "compensated" : "encoded");
+    add_choice(sc, "--" + pre + "latent-target", ra.compensated_target, "compensated", "encoded",
+               "the refiner's target: encoded (target.exr, the paper's) or compensated (the reference encoded with "
+               "the decoder's bias per latent cell added back: decodes closer to it)");
     add_number(sc, "--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints",
                non_negative());
     sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
