@@ -38,8 +38,7 @@ public:
             for (int x = 0; x < width; ++x)
                 for (int c = 0; c < 3; ++c)
                     rgb[(size_t(y) * width + x) * 3 + c] =
-                        latent[(size_t(y / kF) * w + x / kF) * ch + ((y % kF) * kF + x % kF) * 3 + c] -
-                        bias_(x, y, c);
+                        latent[(size_t(y / kF) * w + x / kF) * ch + ((y % kF) * kF + x % kF) * 3 + c] - bias_(x, y, c);
         return rgb;
     }
     const LatentConvention& convention() const override { return conv_; }
@@ -107,6 +106,7 @@ TEST(CompensatedEncode, SplitsABiasIntoTheCastItRemovesAndTheDetailItKeeps) {
     std::vector<float> want(x.size());
     for (int y = 0; y < h; ++y)
         for (int px = 0; px < w; ++px)
-            for (int c = 0; c < 3; ++c) want[(size_t(y) * w + px) * 3 + c] = x[(size_t(y) * w + px) * 3 + c] - checker(px, y, c);
+            for (int c = 0; c < 3; ++c)
+                want[(size_t(y) * w + px) * 3 + c] = x[(size_t(y) * w + px) * 3 + c] - checker(px, y, c);
     EXPECT_LT(max_abs_diff(decoded, want), 1e-6);
 }
