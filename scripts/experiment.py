@@ -136,7 +136,7 @@ def main():
     ap.add_argument("--emitter-response-decay", type=float, default=None,
                     help="every fit's --emitter-response-decay (default: the preset's, else 0; docs/fitting.md (18))")
     ap.add_argument("--refiner-latent-target", choices=["encoded", "compensated"], default=None,
-                    help="the eac fit's refiner target (default: the preset's, else encoded; docs/refiner.md "
+                    help="the refiner target of the fits that refine (default: the preset's, else encoded; docs/refiner.md "
                          "\"Latent target\")")
     ap.add_argument("--second-references", action="store_true",
                     help="also trace every scored frame's reference again with another seed and add Table 1 against "
@@ -166,7 +166,7 @@ def main():
         sys.exit(f"experiment: {c['bin']} not found (bash scripts/build.sh)")
     os.makedirs(c["out"], exist_ok=True)
     lock = open(os.path.join(c["out"], ".experiment.lock"), "w")
-    try:  # released by the kernel once this process and its Snakemake end, however, unlike Snakemake's lock folder
+    try:  # the kernel frees it once this process and its Snakemake have ended, however (unlike Snakemake's lock)
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         sys.exit(f"experiment: {c['out']} is in use by another experiment run (or by the Snakemake of one whose "
