@@ -84,3 +84,9 @@ def lock_is_free(out):
         except BlockingIOError:
             return False
     return True
+
+
+def gone_and_unlocked(groups, out):
+    """True once no process of these groups runs and the folder's lock is free: a killed run
+    has left nothing that could work beside the next one."""
+    return not any(group_members(g) for g in groups) and lock_is_free(out)

@@ -16,7 +16,7 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from processes import alive, group_members, kill_groups, lock_is_free, wait_until  # noqa: E402
+from processes import alive, gone_and_unlocked, group_members, kill_groups, lock_is_free, wait_until  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FAKE_BINARY = """#!/bin/sh
@@ -119,9 +119,8 @@ def kill_alone(tmp, binary):
             f"SIGKILL: a second run beside the orphaned Snakemake was not refused ({second.returncode}): {second.stderr}"
     finally:
         run.kill()
-    groups = run.groups
-    wait_until(lambda: not any(group_members(g) for g in groups), 10)
-    assert run.lock_is_free(), "SIGKILL: the folder is still locked after the run's processes were killed"
+    assert wait_until(lambda: gone_and_unlocked(run.groups, run.out), 10), \
+        "SIGKILL: the run's processes or the folder's lock outlived the kill"
     print("test_interrupt: SIGKILL to experiment.py alone: the folder stayed locked until its Snakemake was gone; "
           "a second run was refused")
     return None

@@ -14,7 +14,7 @@ import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from processes import group_members, groups_below, kill_groups, lock_is_free, wait_until  # noqa: E402
+from processes import gone_and_unlocked, groups_below, kill_groups, wait_until  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TINY = ["--quick", "--image-res", "64", "--frames", "4", "--chunk", "2", "--fit-iterations", "30",
@@ -56,8 +56,7 @@ def main():
     groups = groups_below(p.pid)
     kill_groups(groups)
     p.wait()
-    assert wait_until(lambda: not any(group_members(g) for g in groups) and lock_is_free(killed), 30), \
-        "the killed run's processes live on"
+    assert wait_until(lambda: gone_and_unlocked(groups, killed), 30), "the killed run's processes live on"
     before = finished_marks(killed)
     frames_before = [f for f in before if f.endswith("frame_0000.done")]
     assert frames_before, "the run ended before the kill; nothing was tested"
