@@ -147,7 +147,7 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
                 md.append(f"| {kind} | {label} | {r['rgb_lpips']:.4f} | {r['rgb_mse_x100']:.4f} | {r['latent_dssim']:.4f} |")
             for metric, ylabel in (("lpips", "LPIPS (decoded)"), ("dssim", "D-SSIM (latent)")):
                 svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in configs],
-                               ylabel, xlabel="frame of the edit sequence", xticks=table["e"].get("frames") if step > 1 else None)
+                               ylabel, xlabel="frame of the edit sequence", xticks=sequence_frames(table) if step > 1 else None)
                 write_atomic(os.path.join(out, f"{scene}_{kind}_{metric}.svg"), svg)
         if "convergence" in s:
             md += ["", "Convergence of the eac fit vs latent spp (latent D-SSIM / decoded LPIPS; rendered → refined):", "",
@@ -218,16 +218,13 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
             for metric in ("lpips", "dssim"):
                 with open(os.path.join(out, f"{scene}_{kind}_{metric}.svg")) as f:
                     h.append(f.read())
-            frames = s["edits"][kind]["e"]["frames"]
-            base = "baseline" in fits_of(c)
-            h.append(f"<h3>{kind}: reference / Ĩe / +Ĩa+Ĩc / +refiner{' / baseline + refiner' if base else ''}</h3><table>")
+            columns = strip_columns(fits_of(c))
+            h.append(f"<h3>{kind}: {' / '.join(label for label, _, _ in columns)}</h3><table>")
+            frames = sequence_frames(s["edits"][kind])
             for i in sorted({frames[0], frames[len(frames) // 2], frames[-1]}):
                 d = os.path.join(out, scene)
-                h.append("<tr><td>frame %d</td>" % i + img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_reference.png")) +
-                         img_tag(os.path.join(d, f"{kind}_e", f"frame_{i:04d}.png")) +
-                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}_rendered.png")) +
-                         img_tag(os.path.join(d, f"{kind}_eac", f"frame_{i:04d}.png")) +
-                         (img_tag(os.path.join(d, f"{kind}_baseline", f"frame_{i:04d}.png")) if base else "") + "</tr>")
+                h.append("<tr><td>frame %d</td>" % i + "".join(img_tag(os.path.join(d, f"{kind}_{fit}", png.format(i=i)))
+                                                               for _, fit, png in columns) + "</tr>")
             h.append("</table>")
     if failures:
         h.append("<h2>Ordering check failed</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in failures) + "</ul>")
@@ -498,6 +495,22 @@ def sequence_table(rows):
     return table
 
 
+def sequence_frames(table):
+    """The frames a sequence's table holds (every config of it has the same)."""
+    return next(iter(table.values()))["frames"]
+
+
+def strip_columns(fits):
+    """report.html's image strip of a sequence for the fits run: (label, fit, frame file)."""
+    columns = [("reference", "eac", "frame_{i:04d}_reference.png")]
+    if "e" in fits:
+        columns.append(("Ĩe", "e", "frame_{i:04d}.png"))
+    columns += [("+Ĩa+Ĩc", "eac", "frame_{i:04d}_rendered.png"), ("+refiner", "eac", "frame_{i:04d}.png")]
+    if "baseline" in fits:
+        columns.append(("baseline + refiner", "baseline", "frame_{i:04d}.png"))
+    return columns
+
+
 def without_timings(d):
     """A results dict without its wall-clock entries ("seconds*"), which differ run to run."""
     if not isinstance(d, dict):
@@ -517,9 +530,11 @@ def scene_summary(c, out, scene, failures):
     for kind in KINDS:
         table = sequence_table({name: read_metrics(os.path.join(d, f"{kind}_{name}", "metrics.csv")) for name in fits_of(c)})
         s["edits"][kind] = table
+        if "e" not in table:  # fits narrowed (--config fits=[...]): nothing to order against
+            continue
         base = table["e"]["rgb_lpips"]
         for key in ("ea", "eac"):
-            if table[key]["rgb_lpips"] > base * 1.05:
+            if key in table and table[key]["rgb_lpips"] > base * 1.05:
                 failures.append(f"{scene}/{kind}: {key} LPIPS {table[key]['rgb_lpips']:.4f} worse than e alone {base:.4f}")
     for view in c.get("conv_views", ["training", "novel"]):
         s["convergence"][view] = {}

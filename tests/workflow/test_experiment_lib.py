@@ -3,8 +3,10 @@
 subsets and their chunks cover each evaluated frame exactly once, the paper preset's values and
 their overrides, the Table 1 target check failing where it must, and --second-references' jobs
 and table."""
+import json
 import os
 import sys
+import tempfile
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
@@ -168,6 +170,59 @@ class SecondReferences(unittest.TestCase):
         for part in ("--scene-dir cbox-specular --seed-dir noise_seed1 --seed 1 --ablation --size 1024 --ref-spp 512",
                      "--frames 0,15,30,45"):
             self.assertIn(part, cmd)
+
+
+class NarrowedFits(unittest.TestCase):
+    """write_summary on a finished folder that holds only the fits named in `fits`."""
+    FRAMES = [0, 15, 30, 45]
+    HEADER = ("frame,t,latent_mse,latent_psnr,latent_dssim,rgb_mse_x100,rgb_ssim,rgb_lpips,refined_latent_mse,"
+              "refined_latent_psnr,refined_latent_dssim,refined_rgb_mse_x100,refined_rgb_ssim,refined_rgb_lpips")
+
+    def folder(self, out, scene, lpips_of_fit):
+        d = os.path.join(out, scene)
+        os.makedirs(os.path.join(d, "fit_eac"))
+        with open(os.path.join(d, "fit_eac", "metrics.json"), "w") as f:
+            json.dump({k: {"rgb_lpips": v, "rgb_mse_x100": 1.0} for k, v in
+                       (("rendered", 0.3), ("refined", 0.1), ("vae_roundtrip", 0.05))}, f)
+        with open(os.path.join(d, "equal_error.txt"), "w") as f:
+            f.write("equal error\n")
+        for kind in X.KINDS:
+            for fit, lpips in lpips_of_fit.items():
+                os.makedirs(os.path.join(d, f"{kind}_{fit}"))
+                rows = [f"{i},0,0.01,30,0.2,0.5,0.8,{lpips + 0.001 * i},0.005,33,0.1,0.2,0.9,{lpips / 2}" for i in self.FRAMES]
+                with open(os.path.join(d, f"{kind}_{fit}", "metrics.csv"), "w") as f:
+                    f.write("\n".join([self.HEADER] + rows) + "\n")
+
+    def run_summary(self, fits, lpips_of_fit):
+        c = X.settings(paper=True, scenes=["veach-bidir"])
+        c.update(fits=fits, conv_views=[])
+        with tempfile.TemporaryDirectory() as out:
+            self.folder(out, "veach-bidir", lpips_of_fit)
+            _, failures = X.write_summary(c, out)
+            with open(os.path.join(out, "summary.md")) as f:
+                md = f.read()
+            with open(os.path.join(out, "report.html")) as f:
+                report = f.read()
+            with open(os.path.join(out, "summary.json")) as f:
+                table = json.load(f)["scenes"]["veach-bidir"]["edits"]["light"]
+        return md, report, table, failures
+
+    def test_eac_alone(self):
+        md, report, table, failures = self.run_summary(["eac"], {"eac": 0.2})
+        self.assertEqual(failures, [])
+        self.assertEqual(sorted(table), ["eac", "eac+refiner"])
+        self.assertEqual(table["eac"]["frames"], self.FRAMES)
+        self.assertAlmostEqual(table["eac"]["rgb_lpips"], 0.2 + 0.001 * sum(self.FRAMES) / 4)
+        self.assertIn("| light | +refiner | 0.1000 |", md)
+        self.assertIn("<h3>light: reference / +Ĩa+Ĩc / +refiner</h3>", report)
+        # first, middle and last of the scored frames
+        self.assertEqual([f for f in self.FRAMES if f"<td>frame {f}</td>" in report], [0, 30, 45])
+
+    def test_the_ordering_still_fails_where_it_must(self):
+        _, report, _, failures = self.run_summary(["e", "eac"], {"e": 0.2, "eac": 0.3})
+        self.assertEqual(len(failures), 3, failures)
+        self.assertTrue(all("eac LPIPS" in x and "worse than e alone" in x for x in failures), failures)
+        self.assertIn("<h3>camera: reference / Ĩe / +Ĩa+Ĩc / +refiner</h3>", report)
 
 
 if __name__ == "__main__":
