@@ -106,6 +106,10 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
     add_choice(sc, "--" + pre + "latent-target", ra.compensated_target, "compensated", "encoded",
                "the refiner's target: encoded (target.exr, the paper's) or compensated (the reference encoded with "
                "the decoder's bias per latent cell added back: decodes closer to it)");
+    add_number(sc, "--" + pre + "latent-target-block", ra.latent_target_block,
+               "with the compensated target: pixels of the square blocks the decoder's bias is averaged over "
+               "(0 = one latent cell; coarser keeps only a broader colour cast)",
+               non_negative());
     add_number(sc, "--" + pre + "checkpoint-every", ra.train.checkpoint_every, "refiner steps between checkpoints",
                non_negative());
     sc->add_option("--lpips-dir", ra.lpips_dir, "LPIPS weights folder (default: ../shared/models/lpips)");
@@ -402,20 +406,12 @@ struct Cli {
             ->add_option("--scene", cmp.scene, "scene of the renders: pixels that see an emitter directly are left out")
             ->check(CLI::ExistingFile);
         compare->add_option("-D,--define", cmp_defines, "scene override, as for render");
-        compare->add_option("--block", cmp.block, "block side in pixels")->capture_default_str()->check(positive());
-        compare
-            ->add_option("--sigma", cmp.sigma,
-                         "flag blocks whose ratio is this many standard deviations of its noise from 1")
-            ->capture_default_str()
-            ->check(positive());
-        compare
-            ->add_option("--mean-tolerance", cmp.mean_tolerance,
-                         "verdict: channel means within this relative difference")
-            ->capture_default_str()
-            ->check(non_negative());
-        compare->add_option("--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this")
-            ->capture_default_str()
-            ->check(positive());
+        add_number(compare, "--block", cmp.block, "block side in pixels", positive());
+        add_number(compare, "--sigma", cmp.sigma,
+                   "flag blocks whose ratio is this many standard deviations of its noise from 1", positive());
+        add_number(compare, "--mean-tolerance", cmp.mean_tolerance,
+                   "verdict: channel means within this relative difference", non_negative());
+        add_number(compare, "--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this", positive());
         compare->add_option("--exposure", cmp.exposure, "exposure of the side-by-side previews in stops")
             ->capture_default_str();
         compare->add_option("-o,--out-dir", cmp.out_dir,

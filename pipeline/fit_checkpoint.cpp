@@ -116,6 +116,7 @@ nlohmann::json stage2_settings(const RefineJob& job) {
     if (job.net.arch != RefinerArch::Conv) s["arch"] = to_string(job.net.arch);  // older checkpoints resume
     if (job.net.terms) s["inputs"] = "terms";
     if (job.compensated_target) s["latent_target"] = "compensated";
+    if (job.latent_target_block) s["latent_target_block"] = job.latent_target_block;
     return s;
 }
 

@@ -100,6 +100,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
         {"inference_window", refiner.config().tile},
         {"lpips_crop", job.train.lpips_crop},
         {"latent_target", job.compensated_target ? "compensated" : "encoded"}};
+    if (job.latent_target_block) record["latent_target_block"] = job.latent_target_block;
     if (refiner.config().arch != RefinerArch::Conv) record["arch"] = to_string(refiner.config().arch);
     if (refiner.config().terms) record["inputs"] = "terms";
     return record;
@@ -161,7 +162,13 @@ void require_reference(const RefineJob& job, const Judges& judges, const std::st
 /// job.compensated_target its compensated encoding.
 std::vector<float> latent_target(const RefineJob& job, const Vae& vae, const std::vector<float>& rgb, int width,
                                  int height) {
-    return job.compensated_target ? encode_compensated(vae, rgb, width, height) : vae.encode(rgb, width, height);
+    if (!job.compensated_target) return vae.encode(rgb, width, height);
+    const int block = job.latent_target_block;
+    if (block > 0 && (width % block || height % block))
+        throw std::invalid_argument("refine --latent-target-block (fit --refiner-latent-target-block) " +
+                                    std::to_string(block) + " does not divide the " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " reference into whole blocks");
+    return encode_compensated(vae, rgb, width, height, block);
 }
 
 /// The training examples: every noise view against the target (target.exr, or with
@@ -237,6 +244,9 @@ void validate(const RefineJob& job) {
     require(n.dropout >= 0 && n.dropout <= 0.99f, "dropout", "in [0, 0.99]", n.dropout);
     require(job.noise_views > 0, "noise-views", "> 0", job.noise_views);
     require(t.checkpoint_every >= 0, "checkpoint-every", ">= 0", t.checkpoint_every);
+    require(job.latent_target_block >= 0, "latent-target-block", ">= 0", job.latent_target_block);
+    require(job.latent_target_block == 0 || job.compensated_target, "latent-target-block",
+            "0 unless the latent target is compensated", job.latent_target_block);
 }
 
 RefineSummary run_refine(const RefineJob& job, const Reporter& report) {

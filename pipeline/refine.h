@@ -27,6 +27,9 @@ struct RefineJob {
     /// compensated (vae/compensated_encode.h) instead of its plain encoding, target.exr; needs
     /// reference_rgb.exr (docs/refiner.md "Latent target").
     bool compensated_target = false;
+    /// With compensated_target: the pixels of the square blocks the bias is averaged over; 0 =
+    /// one latent cell (the VAE's downsample factor). Must divide the reference's width and height.
+    int latent_target_block = 0;
     /// Apply the trained refiner on windows the size of its training crop (RefinerConfig::tile)
     /// when InstanceNorm is on and the crop is smaller than the view; false: the whole view at once.
     bool windowed_inference = true;

@@ -83,6 +83,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "augment") job.augment = pipeline::parse_refiner_augment(value.cast<std::string>());
     else if (k == "latent_target")
         job.compensated_target = either(shown, value.cast<std::string>(), "compensated", "encoded");
+    else if (k == "latent_target_block") job.latent_target_block = value.cast<int>();
     else if (k == "checkpoint_every") t.checkpoint_every = value.cast<int>();
     else if (k == "lpips_dir") job.lpips_dir = value.cast<std::string>();
     else if (k == "sampler" && prefix.empty()) job.sampler = sampler_choice(value.cast<std::string>(), shown);

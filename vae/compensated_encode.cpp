@@ -27,12 +27,12 @@ std::vector<float> block_mean(const std::vector<float>& image, int width, int he
     return out;
 }
 
-std::vector<float> encode_compensated(const Vae& vae, const std::vector<float>& rgb, int width, int height) {
+std::vector<float> encode_compensated(const Vae& vae, const std::vector<float>& rgb, int width, int height, int block) {
     const int f = vae.convention().downsample;
     const std::vector<float> roundtrip = vae.decode(vae.encode(rgb, width, height), width / f, height / f);
     std::vector<float> residual(rgb.size());
     for (size_t i = 0; i < rgb.size(); ++i) residual[i] = rgb[i] - roundtrip[i];
-    const std::vector<float> bias = block_mean(residual, width, height, 3, f);
+    const std::vector<float> bias = block_mean(residual, width, height, 3, block > 0 ? block : f);
     std::vector<float> shifted(rgb.size());
     for (size_t i = 0; i < rgb.size(); ++i) shifted[i] = rgb[i] + bias[i];
     return vae.encode(shifted, width, height);

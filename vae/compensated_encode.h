@@ -16,7 +16,9 @@ namespace lpt {
 std::vector<float> block_mean(const std::vector<float>& image, int width, int height, int channels, int f);
 
 /// t′ above for an RGB image in [0, 1] (width × height × 3, multiples of the VAE's downsample
-/// factor); lowpass over blocks of that factor, one block per latent pixel.
-std::vector<float> encode_compensated(const Vae& vae, const std::vector<float>& rgb, int width, int height);
+/// factor); lowpass over blocks of `block` pixels (0: that factor, one block per latent pixel;
+/// coarser blocks keep only a broader cast of the round trip, see docs/refiner.md).
+std::vector<float> encode_compensated(const Vae& vae, const std::vector<float>& rgb, int width, int height,
+                                      int block = 0);
 
 }  // namespace lpt

@@ -142,6 +142,12 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" refine "$out/enc_comp" --iterations 6 --expansion 1 -q --latent-target compensated
     check grep -q '"latent_target": "compensated"' "$out/enc_comp/metrics.json"
     expect_error "latent-target" "$bin" refine "$out/enc_comp" -q --latent-target decoded
+    # ... its bias averaged over coarser blocks: recorded; refused where the blocks do not tile
+    # the reference or the target is not compensated.
+    "$bin" refine "$out/enc_comp" --iterations 6 --expansion 1 -q --latent-target compensated --latent-target-block 16
+    check grep -q '"latent_target_block": 16' "$out/enc_comp/metrics.json"
+    expect_error "latent-target-block) 24 does not divide the 16x16 reference" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target compensated --latent-target-block 24
+    expect_error "latent-target-block (fit --refiner-latent-target-block) must be 0 unless" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target-block 8
     rm "$out/enc_comp/reference_rgb.exr"
     expect_error "reference_rgb.exr: refine --latent-target compensated" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target compensated
     # Fits sharing a training reference through --reference-cache: traced once, the same target

@@ -313,7 +313,8 @@ class OneProcessTest(unittest.TestCase):
             for bad, name in (({"dropout": 1.5}, "dropout"), ({"lr_decay": "linear"}, "lr_decay"),
                               ({"iterations": 0}, "iterations"), ({"augment": "turn"}, "turn"),
                               ({"arch": "mlp"}, "arch"), ({"inputs": "rgb"}, "inputs"),
-                              ({"latent_target": "decoded"}, "latent_target")):
+                              ({"latent_target": "decoded"}, "latent_target"),
+                              ({"latent_target_block": 16}, "latent-target-block")):
                 with self.assertRaises(ValueError) as e:
                     latentpt.refine(fit, note=lambda t: None, **bad)
                 self.assertIn(name, str(e.exception))

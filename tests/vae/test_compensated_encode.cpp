@@ -110,3 +110,21 @@ TEST(CompensatedEncode, SplitsABiasIntoTheCastItRemovesAndTheDetailItKeeps) {
                 want[(size_t(y) * w + px) * 3 + c] = x[(size_t(y) * w + px) * 3 + c] - checker(px, y, c);
     EXPECT_LT(max_abs_diff(decoded, want), 1e-6);
 }
+
+TEST(CompensatedEncode, CoarserBlocksRemoveOnlyTheCastCommonToEachBlock) {
+    // A cast uniform over each 16-pixel block plus a ±0.04 one alternating between its four
+    // latent cells: 8-pixel blocks remove both, 16-pixel blocks the uniform part alone.
+    const int w = 32, h = 32;
+    const std::vector<float> x = random_image(w, h, 4);
+    auto uniform = [](int px, int py, int c) { return 0.02f * float(c + 1) + 0.01f * float(px / 16 + py / 16); };
+    auto alternating = [](int px, int py, int) { return (px / kF + py / kF) % 2 ? 0.04f : -0.04f; };
+    const BiasedVae vae([&](int px, int py, int c) { return uniform(px, py, c) + alternating(px, py, c); });
+    std::vector<float> want(x.size());
+    for (int y = 0; y < h; ++y)
+        for (int px = 0; px < w; ++px)
+            for (int c = 0; c < 3; ++c)
+                want[(size_t(y) * w + px) * 3 + c] = x[(size_t(y) * w + px) * 3 + c] - alternating(px, y, c);
+    EXPECT_LT(max_abs_diff(vae.decode(encode_compensated(vae, x, w, h, 16), w / kF, h / kF), want), 1e-6);
+    EXPECT_LT(max_abs_diff(vae.decode(encode_compensated(vae, x, w, h, kF), w / kF, h / kF), x), 1e-6);
+    EXPECT_EQ(encode_compensated(vae, x, w, h, 0), encode_compensated(vae, x, w, h, kF));  // 0: one latent cell
+}
