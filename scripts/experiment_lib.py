@@ -149,7 +149,7 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
                 svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in configs],
                                ylabel, xlabel="frame of the edit sequence", xticks=sequence_frames(table) if step > 1 else None)
                 write_atomic(os.path.join(out, f"{scene}_{kind}_{metric}.svg"), svg)
-        if "convergence" in s:
+        if s.get("convergence"):  # conv_views=[] runs none
             md += ["", "Convergence of the eac fit vs latent spp (latent D-SSIM / decoded LPIPS; rendered → refined):", "",
                    "| view | spp | D-SSIM | refined D-SSIM | LPIPS | refined LPIPS |", "|---|---|---|---|---|---|"]
             for view, by_spp in s["convergence"].items():

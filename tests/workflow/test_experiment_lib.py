@@ -215,6 +215,7 @@ class NarrowedFits(unittest.TestCase):
         self.assertAlmostEqual(table["eac"]["rgb_lpips"], 0.2 + 0.001 * sum(self.FRAMES) / 4)
         self.assertIn("| light | +refiner | 0.1000 |", md)
         self.assertIn("<h3>light: reference / +Ĩa+Ĩc / +refiner</h3>", report)
+        self.assertNotIn("Convergence", md)  # conv_views=[]: no empty table
         # first, middle and last of the scored frames
         self.assertEqual([f for f in self.FRAMES if f"<td>frame {f}</td>" in report], [0, 30, 45])
 
