@@ -270,7 +270,7 @@ PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
          "frame_step": 15, "ref_spp": 512, "training_ref_spp": 512, "fit_iterations": 3000,
          "refiner_iterations": 6000, "refiner_lr_decay": "cosine", "fits": ["e", "ea", "eac"],
          "spp_list": [1, 4, 16, 64, 256], "conv_views": ["training"], "equal_error_max_spp": 64,
-         "emitter_response_decay": 1e-4}
+         "emitter_response_decay": 1e-4, "refiner_latent_target": "compensated"}
 
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
