@@ -1,4 +1,7 @@
 #include "core/plugin_loader.h"
+#include "core/plugin_interface.h"
+#include "latentpt_interface_fingerprint.h"
+#include <algorithm>
 #include <cstdlib>
 #include <dlfcn.h>
 #include <filesystem>
@@ -39,7 +42,22 @@ std::vector<std::string> plugin_dirs() {
     }
     for (const char* d : {LPT_PLUGIN_BUILD_DIR, LPT_PLUGIN_INSTALL_DIR})
         if (*d) dirs.push_back(d);
-    return dirs;
+    // The executable is usually both homes: each place once, in the order of its first mention.
+    std::vector<std::string> unique;
+    for (const std::string& d : dirs)
+        if (std::find(unique.begin(), unique.end(), d) == unique.end()) unique.push_back(d);
+    return unique;
+}
+
+// Why the opened plugin may not be used, or "" when it may (plugin_interface.h).
+std::string handshake_failure(void* handle) {
+    using InterfaceFn = const char* (*)();
+    const auto theirs = reinterpret_cast<InterfaceFn>(dlsym(handle, kPluginInterfaceSymbol));
+    if (!theirs) return "has no interface fingerprint (built before plugins had one): rebuild it";
+    const std::string value = theirs();
+    if (value == LPT_INTERFACE_FINGERPRINT) return "";
+    return "built from other headers (interface " + value + ", this binary's " + LPT_INTERFACE_FINGERPRINT +
+           "): use the plugin of this binary's build";
 }
 
 void* open_plugin(const std::string& file_name) {
@@ -50,8 +68,15 @@ void* open_plugin(const std::string& file_name) {
             tried += "\n  " + path.string() + ": not there";
             continue;
         }
-        if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
-        tried += "\n  " + path.string() + ": " + dlerror();
+        void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (!handle) {
+            tried += "\n  " + path.string() + ": " + dlerror();
+            continue;
+        }
+        const std::string failure = handshake_failure(handle);
+        if (failure.empty()) return handle;
+        // Passed over but left open: its initialisers have run, and unloading libtorch is not safe.
+        tried += "\n  " + path.string() + ": " + failure;
     }
     throw std::runtime_error("cannot load the plugin " + file_name + " (set LATENTPT_PLUGIN_DIR); tried:" + tried);
 }

@@ -1,7 +1,10 @@
 // liblatentpt_oiio.so: image reading through OpenImageIO, opened on demand by
-// core/image_reader.cpp. It depends on nothing of latentpt but the interface in image_reader.h.
+// core/image_reader.cpp. It depends on nothing of latentpt but the interface in image_reader.h (and the
+// handshake of plugin_interface.h).
 #include "core/error.h"
 #include "core/image_reader.h"
+#include "core/plugin_interface.h"
+#include "latentpt_interface_fingerprint.h"
 #include <OpenImageIO/imageio.h>
 #include <stdexcept>
 
@@ -39,6 +42,8 @@ private:
 
 }  // namespace
 }  // namespace lpt
+
+LPT_DEFINE_PLUGIN_INTERFACE(LPT_INTERFACE_FINGERPRINT)
 
 extern "C" lpt::ImageFileReader* latentpt_open_image_file(const char* path, bool unassociated_alpha,
                                                           std::string* error) {
