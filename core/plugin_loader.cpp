@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <dlfcn.h>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -49,14 +51,24 @@ std::vector<std::string> plugin_dirs() {
     return unique;
 }
 
-// Why the opened plugin may not be used, or "" when it may (plugin_interface.h).
-std::string handshake_failure(void* handle) {
-    using InterfaceFn = const char* (*)();
-    const auto theirs = reinterpret_cast<InterfaceFn>(dlsym(handle, kPluginInterfaceSymbol));
-    if (!theirs) return "has no interface fingerprint (built before plugins had one): rebuild it";
-    const std::string value = theirs();
-    if (value == LPT_INTERFACE_FINGERPRINT) return "";
-    return "built from other headers (interface " + value + ", this binary's " + LPT_INTERFACE_FINGERPRINT +
+// The fingerprint the plugin's file carries (plugin_interface.h), or "" when it has none. Read
+// from the file, not the loaded library, so that a plugin of another build is never run.
+std::string fingerprint_in_file(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::string tag = LPT_PLUGIN_INTERFACE_TAG;
+    const size_t at = bytes.find(tag);
+    if (at == std::string::npos) return "";
+    const size_t end = bytes.find(';', at + tag.size());
+    return end == std::string::npos ? "" : bytes.substr(at + tag.size(), end - at - tag.size());
+}
+
+// Why the plugin at path may not be opened, or "" when it may.
+std::string handshake_failure(const fs::path& path) {
+    const std::string theirs = fingerprint_in_file(path);
+    if (theirs.empty()) return "has no interface fingerprint (built before plugins had one): rebuild it";
+    if (theirs == LPT_INTERFACE_FINGERPRINT) return "";
+    return "built from other headers (interface " + theirs + ", this binary's " + LPT_INTERFACE_FINGERPRINT +
            "): use the plugin of this binary's build";
 }
 
@@ -68,15 +80,12 @@ void* open_plugin(const std::string& file_name) {
             tried += "\n  " + path.string() + ": not there";
             continue;
         }
-        void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-        if (!handle) {
-            tried += "\n  " + path.string() + ": " + dlerror();
+        if (const std::string failure = handshake_failure(path); !failure.empty()) {
+            tried += "\n  " + path.string() + ": " + failure;
             continue;
         }
-        const std::string failure = handshake_failure(handle);
-        if (failure.empty()) return handle;
-        // Passed over but left open: its initialisers have run, and unloading libtorch is not safe.
-        tried += "\n  " + path.string() + ": " + failure;
+        if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
+        tried += "\n  " + path.string() + ": " + dlerror();
     }
     throw std::runtime_error("cannot load the plugin " + file_name + " (set LATENTPT_PLUGIN_DIR); tried:" + tried);
 }

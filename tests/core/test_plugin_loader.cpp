@@ -1,7 +1,8 @@
 // The plugin handshake (core/plugin_interface.h): a plugin built from other headers, or one
 // without the handshake, is passed over for the next place the loader searches, and refused
-// with its reason when no place holds a matching one. The probes (tests/plugin_probe) sit
-// beside this test binary (this build's) and in its other-build/ (another build's, none).
+// with its reason when no place holds a matching one, without ever being opened. The probes
+// (tests/plugin_probe) sit beside this test binary (this build's) and in its other-build/
+// (another build's, none); the refused ones abort the process if their initialisers run.
 #include "core/plugin_loader.h"
 #include <cstdlib>
 #include <filesystem>
@@ -40,8 +41,7 @@ TEST(PluginLoader, PassesOverAPluginOfOtherHeadersForTheOneOfThisBuild) {
 TEST(PluginLoader, RefusesAPluginBuiltFromOtherHeaders) {
     search_other_build_first();
     const std::string why = load_failure("liblatentpt_probe_foreign.so");
-    EXPECT_NE(why.find("other-build/liblatentpt_probe_foreign.so: built from other headers"), std::string::npos)
-        << why;
+    EXPECT_NE(why.find("other-build/liblatentpt_probe_foreign.so: built from other headers"), std::string::npos) << why;
     EXPECT_NE(why.find("another build's"), std::string::npos) << why;
 }
 

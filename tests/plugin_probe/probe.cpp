@@ -4,10 +4,18 @@
 #include "core/plugin_interface.h"
 #include "latentpt_interface_fingerprint.h"
 
+#include <cstdlib>
+
 #if PROBE_MODE == 0
 LPT_DEFINE_PLUGIN_INTERFACE(LPT_INTERFACE_FINGERPRINT)
 #elif PROBE_MODE == 1
 LPT_DEFINE_PLUGIN_INTERFACE("another build's")
+#endif
+
+// A refused plugin must never run: the loader reads the fingerprint from the file, so this
+// initialiser, which ends the test process, runs only if a refused probe is opened.
+#if PROBE_MODE != 0
+[[maybe_unused]] static const int kNeverOpened = (std::abort(), 0);
 #endif
 
 extern "C" int latentpt_probe_mode() { return PROBE_MODE; }
