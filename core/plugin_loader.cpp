@@ -2,6 +2,7 @@
 #include "core/plugin_interface.h"
 #include "latentpt_interface_fingerprint.h"
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <dlfcn.h>
 #include <filesystem>
@@ -57,10 +58,16 @@ std::string fingerprint_in_file(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     const std::string tag = LPT_PLUGIN_INTERFACE_TAG;
-    const size_t at = bytes.find(tag);
-    if (at == std::string::npos) return "";
-    const size_t end = bytes.find(';', at + tag.size());
-    return end == std::string::npos ? "" : bytes.substr(at + tag.size(), end - at - tag.size());
+    // The tag alone (a library holding this loader's code) ends in '\0', not in a value and ';'.
+    for (size_t at = bytes.find(tag); at != std::string::npos; at = bytes.find(tag, at + 1)) {
+        const size_t begin = at + tag.size();
+        size_t end = begin;
+        while (end < bytes.size() && end - begin < 64 && std::isprint(static_cast<unsigned char>(bytes[end])) &&
+               bytes[end] != ';')
+            ++end;
+        if (end < bytes.size() && bytes[end] == ';' && end > begin) return bytes.substr(begin, end - begin);
+    }
+    return "";
 }
 
 // Why the plugin at path may not be opened, or "" when it may.

@@ -10,6 +10,9 @@
 LPT_DEFINE_PLUGIN_INTERFACE(LPT_INTERFACE_FINGERPRINT)
 #elif PROBE_MODE == 1
 LPT_DEFINE_PLUGIN_INTERFACE("another build's")
+#else
+// The tag without a value, as in a library that holds the loader's code: not a fingerprint.
+extern "C" __attribute__((used)) const char latentpt_probe_bare_tag[] = LPT_PLUGIN_INTERFACE_TAG;
 #endif
 
 // A refused plugin must never run: the loader reads the fingerprint from the file, so this
