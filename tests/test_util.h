@@ -1,7 +1,11 @@
-// Shared test helpers: temp files, the ../shared data folder, statistics.
+// Shared test helpers: temp files, the ../shared data folder, statistics, error messages.
 #pragma once
+#include <gtest/gtest.h>
 #include <cstdint>
+#include <initializer_list>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lpt::test {
@@ -15,5 +19,29 @@ std::string temp_dir(const std::string& name);
 std::string shared_dir();
 /// n deterministic weights uniform in [-1, 1): a loss Σ W · Ĩ whose gradient d_image is W.
 std::vector<float> random_weights(size_t n, uint64_t seed);
+
+/// The message of the std::runtime_error `run` throws; "" when it returns normally.
+template <class Run>
+std::string runtime_error_of(Run&& run) {
+    try {
+        std::forward<Run>(run)();
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+/// `run` must throw std::runtime_error naming each of `parts` (a bad input's file and field);
+/// `if_accepted` says what went wrong when it returns instead.
+template <class Run>
+void expect_error_naming(Run&& run, std::initializer_list<std::string> parts,
+                         const std::string& if_accepted = "the bad input was accepted") {
+    const std::string what = runtime_error_of(std::forward<Run>(run));
+    if (what.empty()) {
+        ADD_FAILURE() << if_accepted;
+        return;
+    }
+    for (const std::string& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what;
+}
 
 }  // namespace lpt::test

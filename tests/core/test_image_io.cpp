@@ -51,12 +51,6 @@ TEST(ImageIo, HugeHeaderIsRefusedBeforeAllocating) {
     const std::string png =
         std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + png_chunk("IDAT", "") + png_chunk("IEND", "");
     const std::string path = test::write_temp_file("huge.png", png);
-    try {
-        read_image(path);
-        FAIL() << "a 200000 x 200000 header must be refused";
-    } catch (const std::runtime_error& e) {
-        const std::string what = e.what();
-        EXPECT_NE(what.find("huge.png"), std::string::npos) << what;
-        EXPECT_NE(what.find("GiB"), std::string::npos) << what;
-    }
+    test::expect_error_naming([&] { read_image(path); }, {"huge.png", "GiB"},
+                              "a 200000 x 200000 header must be refused");
 }

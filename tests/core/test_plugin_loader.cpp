@@ -4,6 +4,7 @@
 // (tests/plugin_probe) sit beside this test binary (this build's) and in its other-build/
 // (another build's, none); the refused ones abort the process if their initialisers run.
 #include "core/plugin_loader.h"
+#include "test_util.h"
 #include <cstdlib>
 #include <filesystem>
 #include <gtest/gtest.h>
@@ -21,12 +22,7 @@ void search_other_build_first() {
 }
 
 std::string load_failure(const std::string& file_name) {
-    try {
-        lpt::plugin_symbol(file_name, "latentpt_probe_mode");
-    } catch (const std::runtime_error& e) {
-        return e.what();
-    }
-    return "";
+    return lpt::test::runtime_error_of([&] { lpt::plugin_symbol(file_name, "latentpt_probe_mode"); });
 }
 
 }  // namespace

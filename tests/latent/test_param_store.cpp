@@ -1,5 +1,6 @@
 // ParamStore: maps, their derivatives (central differences), clamps and JSON round trip.
 #include "latent/param_store.h"
+#include "test_util.h"
 #include <gtest/gtest.h>
 #include <cmath>
 
@@ -120,13 +121,8 @@ TEST(ParamStore, JsonRoundTripIsExact) {
 TEST(ParamStore, JsonErrorsNameFileAndParameter) {
     ParamStore ps = make_store();
     auto expect_error = [&](const std::string& json, const std::string& needle) {
-        try {
-            ps.load_json(json, "fit/params.json");
-            FAIL() << "expected an error for " << json;
-        } catch (const std::runtime_error& e) {
-            EXPECT_NE(std::string(e.what()).find("fit/params.json"), std::string::npos) << e.what();
-            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-        }
+        test::expect_error_naming([&] { ps.load_json(json, "fit/params.json"); }, {"fit/params.json", needle},
+                                  "expected an error for " + json);
     };
     expect_error(R"({"slices": [{"name": "ghost.La", "raw": [0,0,0,0]}]})", "ghost.La");
     expect_error(R"({"slices": [{"name": "a.La", "raw": [0,0]}]})", "a.La");

@@ -53,18 +53,6 @@ pipeline::EditJob demo_edit_of_a_small_fit(const std::string& dir) {
     return edit;
 }
 
-/// Runs `run`, which must throw std::runtime_error naming each of `parts`; `if_accepted` says
-/// what went wrong when it does not throw.
-template <class Run>
-void expect_error_naming(Run run, std::initializer_list<const char*> parts, const char* if_accepted) {
-    try {
-        run();
-        ADD_FAILURE() << if_accepted;
-    } catch (const std::runtime_error& e) {
-        for (const char* part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-    }
-}
-
 pipeline::Reporter cancel_after(int step) {
     pipeline::Reporter r;
     r.progress = [step](const pipeline::StageProgress& p) { return p.step < step; };
@@ -98,8 +86,8 @@ TEST(Pipeline, ResumeRefusesOrRestartsACheckpointOfOtherSettings) {
     pipeline::run_fit(job);
     job.options.emission_decay = 0.5f;
     job.resume = true;
-    expect_error_naming([&] { pipeline::run_fit(job); }, {"checkpoint/settings.json", "emission_decay"},
-                        "resumed a checkpoint made with another emission decay");
+    test::expect_error_naming([&] { pipeline::run_fit(job); }, {"checkpoint/settings.json", "emission_decay"},
+                              "resumed a checkpoint made with another emission decay");
     job.restart_if_changed = true;
     const pipeline::FitSummary restarted = pipeline::run_fit(job);
     pipeline::FitJob fresh = small_fit(dir + "/fresh");
@@ -236,8 +224,8 @@ TEST(Pipeline, RefinerNoiseViewsAreRenderedFromTheFit) {
     ASSERT_NE(at, std::string::npos);
     manifest.replace(at, 11, "\"final_spx\"");
     std::ofstream(r.fitdir + "/fit.json") << manifest;
-    expect_error_naming([&] { pipeline::run_refine(r); }, {"stage1.final_spp", "fit.json"},
-                        "a fit.json without stage1.final_spp was accepted");
+    test::expect_error_naming([&] { pipeline::run_refine(r); }, {"stage1.final_spp", "fit.json"},
+                              "a fit.json without stage1.final_spp was accepted");
 }
 
 // Augmented views need the path-traced reference they are encoded from: a fit with a synthetic
@@ -246,8 +234,8 @@ TEST(Pipeline, RefinerNoiseViewsAreRenderedFromTheFit) {
 TEST(Pipeline, RefinerAugmentationNeedsThePathTracedReference) {
     pipeline::RefineJob r = small_refine(test::temp_dir("pipeline-augment"), 4);
     r.augment = pipeline::RefinerAugment::Mirror;
-    expect_error_naming([&] { pipeline::run_refine(r); }, {"reference_rgb.exr", "--refiner-augment mirror"},
-                        "augmentation without reference_rgb.exr was accepted");
+    test::expect_error_naming([&] { pipeline::run_refine(r); }, {"reference_rgb.exr", "--refiner-augment mirror"},
+                              "augmentation without reference_rgb.exr was accepted");
 }
 
 TEST(Pipeline, RefinerResumeRefusesOrRestartsACheckpointOfOtherSettings) {
@@ -260,8 +248,8 @@ TEST(Pipeline, RefinerResumeRefusesOrRestartsACheckpointOfOtherSettings) {
     pipeline::run_refine(r);
     r.train.iterations = 8;
     r.resume = true;
-    expect_error_naming([&] { pipeline::run_refine(r); }, {"refiner_checkpoint.json", "iterations"},
-                        "resumed a refiner checkpoint trained for another iteration count");
+    test::expect_error_naming([&] { pipeline::run_refine(r); }, {"refiner_checkpoint.json", "iterations"},
+                              "resumed a refiner checkpoint trained for another iteration count");
     r.restart_if_changed = true;
     const pipeline::RefineSummary restarted = pipeline::run_refine(r);
     pipeline::RefineJob fresh = r;

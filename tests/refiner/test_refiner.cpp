@@ -268,14 +268,13 @@ TEST(Refiner, SaveLoadAndResumeReproduceOutputs) {
     EXPECT_EQ(loaded->config().distance_scale, 2.5f);
     EXPECT_EQ(loaded->config().expansion, 2);
 
-    std::ofstream(temp_path("junk.pt")) << "not a refiner";
-    try {
-        Refiner::load(temp_path("junk.pt"));
-        FAIL() << "junk accepted";
-    } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("junk.pt"), std::string::npos) << e.what();
-    }
-    EXPECT_THROW(Refiner::load(temp_path("missing.pt")), std::runtime_error);
+    // temp_path writes an empty file: name the paths once (an empty file, junk, a missing one).
+    test::expect_error_naming([] { Refiner::load(temp_path("empty.pt")); }, {"empty.pt"}, "an empty file accepted");
+    const std::string junk = temp_path("junk.pt");
+    std::ofstream(junk) << "not a refiner";
+    test::expect_error_naming([&] { Refiner::load(junk); }, {"junk.pt"}, "junk accepted");
+    const std::string missing = test::temp_dir("refiner-missing") + "/missing.pt";
+    test::expect_error_naming([&] { Refiner::load(missing); }, {"missing.pt"}, "a missing file accepted");
 }
 
 // Without InstanceNorm the refiner is a plain convolution network: a crop's interior is refined
@@ -311,12 +310,8 @@ TEST(Refiner, WithoutInstanceNormACropIsRefinedAsTheWholeView) {
     Refiner::create(small(), 4)->train(p.in, p.target, nullptr, nullptr, nullptr, o);
     o.iterations = 4;
     o.resume = true;
-    try {
-        Refiner::create(cfg, 4)->train(p.in, p.target, nullptr, nullptr, nullptr, o);
-        FAIL() << "an InstanceNorm checkpoint resumed without InstanceNorm";
-    } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("--norm instance"), std::string::npos) << e.what();
-    }
+    test::expect_error_naming([&] { Refiner::create(cfg, 4)->train(p.in, p.target, nullptr, nullptr, nullptr, o); },
+                              {"--norm instance"}, "an InstanceNorm checkpoint resumed without InstanceNorm");
 }
 
 // Windowed inference (RefinerConfig::tile, docs/refiner.md "Windows"): the refined view is, per

@@ -67,12 +67,8 @@ TEST(Taesd3, RejectsBadSizesAndFiles) {
         EXPECT_NE(std::string(e.what()).find("not a multiple of 8"), std::string::npos) << e.what();
     }
     EXPECT_THROW(vae->decode(std::vector<float>(10), 2, 2), std::invalid_argument);
-    try {
-        load_taesd(shared + "/models/taesd3", "taesd_missing");
-        FAIL();
-    } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("taesd_missing_encoder.safetensors"), std::string::npos) << e.what();
-    }
+    test::expect_error_naming([&] { load_taesd(shared + "/models/taesd3", "taesd_missing"); },
+                              {"taesd_missing_encoder.safetensors"});
     // TAEF1 has the same layout: it loads (a second latent space through the same code).
     EXPECT_NO_THROW(load_taesd(shared + "/models/taef1", "taef1", LatentConvention{16, 8, 0.3611f, 0.1159f}));
 }

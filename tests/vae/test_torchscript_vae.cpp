@@ -106,12 +106,8 @@ TEST(TorchScriptVae, BadFilesAndConfigsNameTheProblem) {
     const fs::path d = test::temp_dir("torchscript-bad");
     auto expect_error = [](const std::string& enc, const std::string& dec, const std::string& cfg,
                            const std::string& needle) {
-        try {
-            load_torchscript_vae(enc, dec, cfg);
-            ADD_FAILURE() << "accepted; expected an error with '" << needle << "'";
-        } catch (const std::runtime_error& e) {
-            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-        }
+        test::expect_error_naming([&] { load_torchscript_vae(enc, dec, cfg); }, {needle},
+                                  "accepted; expected an error with '" + needle + "'");
     };
     const std::string cfg = (d / "vae.json").string(), junk = (d / "junk.pt").string();
     std::ofstream(junk) << "not a module";
