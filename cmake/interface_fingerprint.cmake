@@ -1,13 +1,14 @@
-# cmake -DLIST_FILE=... -DSOURCE_DIR=... -DOUTPUT=... -P interface_fingerprint.cmake
+# cmake -DLIST_FILE=... -DSOURCE_DIR=... -DTOOLCHAIN=... -DOUTPUT=... -P interface_fingerprint.cmake
 #
 # Writes OUTPUT, `#define LPT_INTERFACE_FINGERPRINT "<hash>"`: the SHA-256 (first 16 hex digits)
-# of every header named in LIST_FILE, by path below SOURCE_DIR and content. Run at build time
+# of every header named in LIST_FILE, by path below SOURCE_DIR and content, and of TOOLCHAIN
+# (compiler, its version and the options that change types or the runtime). Run at build time
 # (CMakeLists.txt, target lpt_interface_fingerprint) so that a header edit re-hashes without
 # reconfiguring; OUTPUT is rewritten only when the value changes, so only its includers
 # recompile. core/plugin_interface.h says what the value is for.
 file(STRINGS "${LIST_FILE}" headers)
 list(SORT headers)
-set(listing "")
+set(listing "toolchain ${TOOLCHAIN}\n")
 foreach(header IN LISTS headers)
   file(SHA256 "${header}" digest)
   file(RELATIVE_PATH name "${SOURCE_DIR}" "${header}")

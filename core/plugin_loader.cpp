@@ -75,8 +75,8 @@ std::string handshake_failure(const fs::path& path) {
     const std::string theirs = fingerprint_in_file(path);
     if (theirs.empty()) return "has no interface fingerprint (built before plugins had one): rebuild it";
     if (theirs == LPT_INTERFACE_FINGERPRINT) return "";
-    return "built from other headers (interface " + theirs + ", this binary's " + LPT_INTERFACE_FINGERPRINT +
-           "): use the plugin of this binary's build";
+    return "built from other headers or with another toolchain (interface " + theirs + ", this binary's " +
+           LPT_INTERFACE_FINGERPRINT + "): use the plugin of this binary's build";
 }
 
 void* open_plugin(const std::string& file_name) {
