@@ -1,10 +1,10 @@
 // Refiner network: construction, inference, and the refiner.pt file (a torch::serialize
 // archive holding the weights and the RefinerConfig, written atomically).
 #include "refiner/refiner_net.h"
+#include "vae/torch_threads.h"
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -15,8 +15,6 @@ namespace {
 torch::nn::Conv2d conv(int64_t in, int64_t out, int64_t k) {
     return torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, k).padding(k / 2));
 }
-
-void use_all_cores() { at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency()))); }
 
 /// Origins of windows of `window` pixels along an axis of `size`: every window/2 pixels, and the
 /// last one flush with the far edge, so that every pixel is covered.
@@ -142,7 +140,7 @@ Refiner::Refiner(std::unique_ptr<Impl> impl) : m(std::move(impl)) {}
 Refiner::~Refiner() = default;
 
 std::unique_ptr<Refiner> Refiner::create(const RefinerConfig& config, uint64_t seed) {
-    use_all_cores();
+    use_worker_threads_in_torch();
     torch::manual_seed(seed);
     auto impl = std::make_unique<Impl>(Impl{config, RefinerNet(config)});
     // A zero head makes the untrained refiner the identity: stage 2 starts from stage 1's result.
@@ -189,7 +187,7 @@ void Refiner::save(const std::string& path) const {
 
 std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
     if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": refiner file not found");
-    use_all_cores();
+    use_worker_threads_in_torch();
     try {
         torch::serialize::InputArchive ar;
         ar.load_from(path);

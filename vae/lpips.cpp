@@ -5,9 +5,9 @@
 // spatial mean, sum over layers. Weights come from one safetensors file read by our reader.
 #include "vae/lpips_torch.h"
 #include "vae/safetensors.h"
+#include "vae/torch_threads.h"
 #include <algorithm>
 #include <stdexcept>
-#include <thread>
 
 namespace lpt {
 
@@ -144,8 +144,8 @@ LpipsNet load_lpips_net(const std::string& dir) {
     n.shift = n.w.at("scaling.shift");
     n.scale = n.w.at("scaling.scale");
     for (int k = 0; k < Lpips::kLayers; ++k) n.lin[k] = n.w.at("lin." + std::to_string(k) + ".weight");
-    // Intra-op threads default to 1 here; convolutions dominate, so use the machine (as taesd.cpp).
-    at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency())));
+    // Intra-op threads default to 1 here; convolutions dominate, so use the worker threads.
+    use_worker_threads_in_torch();
     return n;
 }
 

@@ -4,11 +4,11 @@
 // nearest 2x upsampling, and a 3·tanh(x/3) soft clamp at the decoder input. Weights are BF16
 // safetensors converted to float32 by our reader (vae/safetensors.h).
 #include "vae/safetensors.h"
+#include "vae/torch_threads.h"
 #include "vae/vae_torch.h"
 #include <torch/torch.h>
 #include <algorithm>
 #include <stdexcept>
-#include <thread>
 
 namespace lpt {
 
@@ -74,8 +74,8 @@ public:
         expect_conv(dec, "19", 3, kC, true);
         m_enc = load_weights(dir + "/" + prefix + "_encoder.safetensors", enc);
         m_dec = load_weights(dir + "/" + prefix + "_decoder.safetensors", dec);
-        // Intra-op threads default to 1 here; convolutions dominate, so use the machine.
-        at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency())));
+        // Intra-op threads default to 1 here; convolutions dominate, so use the worker threads.
+        use_worker_threads_in_torch();
     }
 
     torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {

@@ -5,12 +5,12 @@
 // Images cross this interface in [0, 1] and latents in the diffusion model's space; the affine
 // maps to and from the modules' own ranges happen here, so the modules stay plain exports.
 #include "vae/vae_config.h"
+#include "vae/torch_threads.h"
 #include "vae/vae_torch.h"
 #include <torch/script.h>
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
-#include <thread>
 
 namespace lpt {
 
@@ -45,7 +45,7 @@ public:
         m_decoder_path = decoder;
         m_enc = load_module(encoder, "encoder");
         m_dec = load_module(decoder, "decoder");
-        at::set_num_threads(std::max(1, int(std::thread::hardware_concurrency())));
+        use_worker_threads_in_torch();
     }
 
     torch::Tensor encode_nchw(const torch::Tensor& rgb) const override {
