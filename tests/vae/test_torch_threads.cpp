@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 #include <torch/torch.h>
+#include <algorithm>
 
 using namespace lpt;
 
