@@ -2,6 +2,7 @@
 // only translation unit that includes CLI11; each subcommand's options fill a plain struct.
 #include "apps/commands.h"
 #include "apps/torch_commands.h"
+#include "core/process_memory.h"
 #include "integrators/path.h"
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -148,8 +149,9 @@ struct Cli {
             ->check(positive());
         render
             ->add_option("--ref-seed", r.ref_seed,
-                         "with --reference: the references' seed; another one traces independent references of the "
-                         "same frames (cached under their own names), e.g. to measure their noise")
+                         "with --reference: the references' seed (each edited frame traces with a seed made from "
+                         "it and the frame's index); another one traces independent references of the same frames "
+                         "(cached under their own names), e.g. to measure their noise")
             ->capture_default_str();
         render->add_option("--reference-cache", r.reference_cache,
                            "with --reference: keep path-traced frames in this folder and reuse them "
@@ -467,6 +469,7 @@ struct Cli {
 }  // namespace lpt::app
 
 int main(int argc, char** argv) {
+    lpt::reuse_freed_memory();  // before any thread: the networks' large blocks stay on the heap
     lpt::app::Cli cli;
     CLI::App app{"latentpt: a differentiable path tracer that renders into the latent space of an image autoencoder"};
     app.require_subcommand(1);
