@@ -90,23 +90,24 @@ std::string frame_metrics(const std::vector<float>& latent, const std::vector<fl
     return o.str();
 }
 
-/// The encoded reference of the edited frame and its display RGB. The edited scene file is not on
+/// The encoded reference of frame `index` and its display RGB. The edited scene file is not on
 /// disk: path trace this Scene directly, or take the frame from the cache (experiments compare
 /// several fits on one sequence). An unedited frame (without -D overrides) is the training view:
 /// it is cached under the key `fit --reference-cache` uses, so every sequence's unedited frames
-/// and the fits share one trace.
-std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, const Tools& t, const std::string& frame,
-                                   bool unedited, const std::string& stem, int w, int h, std::vector<float>& ref_rgb) {
+/// and the fits share one trace. An edited frame is traced with its own seed (edited_frame_seed).
+std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, const Tools& t, int index,
+                                   const std::string& frame, bool unedited, const std::string& stem, int w, int h,
+                                   std::vector<float>& ref_rgb) {
+    const uint64_t seed = unedited ? job.ref_seed : edited_frame_seed(job.ref_seed, index);
     std::string cached;
     if (!job.reference_cache.empty())
         cached = (fs::path(job.reference_cache) /
                   ((unedited ? training_reference_key(8 * w, 8 * h, job.ref_spp, fit.ref_tone)
-                             : fs::path(job.edits).stem().string() + "_" + std::to_string(8 * w) + "x" +
-                                   std::to_string(8 * h) + "_" + std::to_string(job.ref_spp) + "spp_" + fit.ref_tone +
-                                   "_" + frame) +
+                             : edited_frame_reference_key(fs::path(job.edits).stem().string(), 8 * w, 8 * h,
+                                                          job.ref_spp, fit.ref_tone, frame)) +
                    reference_seed_suffix(job.ref_seed)))
                      .string();
-    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, job.ref_seed, fit.ref_tone, *t.vae, cached,
+    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, seed, fit.ref_tone, *t.vae, cached,
                                     stem + "_reference.png", ref_rgb);
 }
 
@@ -132,8 +133,8 @@ std::string render_frame(const EditJob& job, EditSession& session, const Tools& 
     }
     if (!job.reference) return {};
     std::vector<float> ref_rgb;
-    const std::vector<float> ref =
-        frame_reference(job, session.fit(), t, name, session.unedited(i) && job.defines.empty(), stem, w, h, ref_rgb);
+    const std::vector<float> ref = frame_reference(job, session.fit(), t, i, name,
+                                                   session.unedited(i) && job.defines.empty(), stem, w, h, ref_rgb);
     std::ostringstream row;
     row << i << "," << session.time(i) << frame_metrics(latent, ref, ref_rgb, w, h, t);
     if (refiner) row << frame_metrics(refined, ref, ref_rgb, w, h, t);
@@ -159,7 +160,8 @@ std::string frame_key(const EditJob& job) {
     if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before
     add(std::to_string(job.width) + "x" + std::to_string(job.height) + " spp " + std::to_string(job.spp) + " seed " +
         std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp) +
-        reference_seed_suffix(job.ref_seed));  // empty for the default seed: keys as before
+        reference_seed_suffix(job.ref_seed));     // empty for the default seed: keys as before
+    if (job.reference) add(kEditedFrameSeedTag);  // edited frames' references changed seeds: score them again
     char buf[40];
     std::snprintf(buf, sizeof buf, "key %016llx", static_cast<unsigned long long>(h));
     return buf;

@@ -1,6 +1,7 @@
 #include "pipeline/reference.h"
 #include "core/image_io.h"
 #include "pipeline/fit_folder.h"
+#include "core/sampler.h"
 #include "core/scene.h"
 #include "integrators/path.h"
 #include "vae/vae.h"
@@ -40,6 +41,16 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
 std::string training_reference_key(int width, int height, int spp, const std::string& tone) {
     return "training_" + std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) + "spp_" +
            tone;
+}
+
+std::string edited_frame_reference_key(const std::string& edits_stem, int width, int height, int spp,
+                                       const std::string& tone, const std::string& frame_name) {
+    return edits_stem + "_" + std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) +
+           "spp_" + tone + "_" + frame_name + kEditedFrameSeedTag;
+}
+
+uint64_t edited_frame_seed(uint64_t ref_seed, int frame) {
+    return mix64(ref_seed ^ mix64(uint64_t(frame) + 1));  // frame + 1: frame 0 too differs from ref_seed
 }
 
 std::string reference_seed_suffix(uint64_t seed) {

@@ -31,6 +31,17 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
 /// The cache name of a view's training reference ("training_<W>x<H>_<spp>spp_<tone>"): fits
 /// and the unedited frames of edit sequences share it.
 std::string training_reference_key(int width, int height, int spp, const std::string& tone);
+/// The cache name of an edited frame's reference ("<edits stem>_<W>x<H>_<spp>spp_<tone>_<frame
+/// name>_own_seed"): the suffix marks references traced with edited_frame_seed, so a cache
+/// written when every frame shared one seed is not read as theirs.
+std::string edited_frame_reference_key(const std::string& edits_stem, int width, int height, int spp,
+                                       const std::string& tone, const std::string& frame_name);
+/// The tag edited_frame_reference_key ends with.
+inline constexpr const char* kEditedFrameSeedTag = "_own_seed";
+/// The seed of edited frame `frame`'s reference under `ref_seed`: each frame its own stream, so the
+/// references of one sequence do not share their noise (with one seed for all, a frame's noise
+/// repeats in the next wherever the view changes little, and the sequence mean keeps it).
+uint64_t edited_frame_seed(uint64_t ref_seed, int frame);
 /// What a cache key gains for a reference of another seed ("_seed<N>"; nothing for
 /// kReferenceSeed, so caches written before the option keep their names).
 std::string reference_seed_suffix(uint64_t seed);

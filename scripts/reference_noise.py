@@ -84,9 +84,13 @@ def mean_png(a, b, png):
 
 
 def reference_stem(refs, sequence, size, spp, frame, seed_suffix=""):
+    """A cached reference's path without .exr: the training view's for frame 0, else the edited
+    frame's, traced with its own seed (`_own_seed`), or in folders made before that, with r₁'s."""
     if frame == 0:
         return os.path.join(refs, f"training_{size}x{size}_{spp}spp_clip{seed_suffix}")
-    return os.path.join(refs, f"edits-{sequence}_{size}x{size}_{spp}spp_clip_frame_{frame:04d}{seed_suffix}")
+    stem = os.path.join(refs, f"edits-{sequence}_{size}x{size}_{spp}spp_clip_frame_{frame:04d}")
+    own = f"{stem}_own_seed{seed_suffix}"
+    return own if os.path.exists(own + ".exr") or not os.path.exists(stem + seed_suffix + ".exr") else stem + seed_suffix
 
 
 def frame_row(m, x_png, r1, r2, rbar, r12):
@@ -141,7 +145,7 @@ def main():
                         "of --folder's rendered and refined frames, and write Table 1 against each reference")
     p.add_argument("--report", default="reference_noise", help="report name (.md and .json in the seed dir)")
     p.add_argument("--sequences", default="camera,object,light")
-    p.add_argument("--frames", default="0,15,30,45")
+    p.add_argument("--frames", default="0,20,40")
     p.add_argument("--size", type=int, default=1024, help="reference width = height")
     p.add_argument("--ref-spp", type=int, default=512)
     p.add_argument("--bin", default="build/apps/latentpt")
