@@ -115,7 +115,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="one scene, small and short; checks the ablation ordering (CI)")
     ap.add_argument("--paper", action="store_true",
                     help="the paper-scale preset (issue 16): cbox-specular at 1024² (128² latents), veach-bidir and "
-                         "dining-room at 512², frames 0, 15, 30, 45 at 512 spp, 3000 stage-1 iterations, 6000 refiner "
+                         "dining-room at 512², frames 0, 20, 40 at 512 spp, 3000 stage-1 iterations, 6000 refiner "
                          "steps with cosine decay, emitter response decay 1e-4, no baseline; other flags override its values "
                          "(docs/results.md)")
     ap.add_argument("--scenes", default=None, help="comma-separated subset of " + ", ".join(X.SCENES))

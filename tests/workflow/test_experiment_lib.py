@@ -166,13 +166,15 @@ class SecondReferences(unittest.TestCase):
         md = X.independent_table1_lines(c, {"cbox-specular": self.result()})
         self.assertIn("cbox-specular 1.1000", md[2])  # σ² over both frames of every sequence
         self.assertTrue(any(line.startswith("| Cornell Box 1024² | camera |") for line in md), md)
+        step = X.PAPER["frame_step"]  # the preset's frames, every step-th of the 60
+        scored = list(range(0, 60, step))
         cmd = X.second_reference_command(c, "cbox-specular", "light", 2)
         for part in ("cbox-specular/fit_eac --edit cbox-specular/edits-light.json", "--ref-spp 512", "--ref-seed 1",
-                     "--out cbox-specular/noise_seed1/light", "--frames 0:45:15", "--resume"):
+                     "--out cbox-specular/noise_seed1/light", f"--frames 0:{scored[-1]}:{step}", "--resume"):
             self.assertIn(part, cmd)
         cmd = X.reference_noise_command(c, "cbox-specular")
         for part in ("--scene-dir cbox-specular --seed-dir noise_seed1 --seed 1 --ablation --size 1024 --ref-spp 512",
-                     "--frames 0,15,30,45"):
+                     "--frames " + ",".join(map(str, scored))):
             self.assertIn(part, cmd)
 
 
