@@ -127,7 +127,7 @@ def main():
     ap.add_argument("--ref-spp", type=int, default=None, help="samples per pixel of the RGB references (default: per scene, 128-256)")
     ap.add_argument("--fit-iterations", type=int, default=None)
     ap.add_argument("--refiner-iterations", type=int, default=None)
-    ap.add_argument("--frame-step", type=int, default=None, help="evaluate every N-th frame of each edit sequence (default 1)")
+    ap.add_argument("--frame-step", type=int, default=None, help="evaluate every N-th frame of each edit sequence (default 1; --paper: 20)")
     ap.add_argument("--spp", type=int, default=64, help="latent samples per pixel of the edited frames")
     ap.add_argument("--param", choices=["code", "gain"], default=None,
                     help="every ablation fit's --param (default: the preset's, else code; docs/params.md (4))")

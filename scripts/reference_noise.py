@@ -14,10 +14,11 @@ E MSE(r₁, r₂) = 2σ² (σ²: a reference's variance per value; r*: its expec
 
 without bias from the references' noise, up to the display mapping's curvature (r* is the
 expectation of the display-mapped reference, not the display-mapped expectation). That needs x
-independent of both references. r₁ shares its seed with the training view's reference, the fit's
-and the refiner's target, so where the camera holds still r₁'s noise is partly the target's, and
-a refiner reproduces some of it: then only r₂ is independent of x, and MSE(x, r₂) − σ² is the
-unbiased estimate. LPIPS has no such identity: the script prints it against r₁, r₂ and their
+independent of both references. On frame 0 r₁ is the training view's reference, the fit's and
+the refiner's target, whose noise a refiner reproduces in part: there only r₂ is independent of x,
+and MSE(x, r₂) − σ² is the unbiased estimate. Edited frames' references have had their own seeds
+since session 29 (docs/metrics.md); in folders made before, r₁ shared the target's seed on every
+frame, so where the camera held still its noise was partly the target's there too. LPIPS has no such identity: the script prints it against r₁, r₂ and their
 mean (twice the spp). The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ².
 
     python3 scripts/reference_noise.py --scene-dir results-paper/cbox-specular --seed-dir noise_seed1

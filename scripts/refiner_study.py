@@ -4,7 +4,9 @@
 Every variant but 'default' retrains the refiner of one stage-1 fit (a copy of the fit folder,
 the refiner removed) with `latentpt refine <options>`; each then renders the experiment's edit sequences with it
 against the experiment's path-traced references (read from its reference cache, never traced
-again) and reports the mean refined LPIPS / MSE×100 over the edited frames. Training uses the
+again; an experiment folder made before session 29 lacks the edited frames' own-seed references,
+docs/metrics.md, so the first variant traces them, and rows of earlier runs kept in study.md
+were scored against the old ones: start such a study in a fresh folder) and reports the mean refined LPIPS / MSE×100 over the edited frames. Training uses the
 single training view only: no edited frame or its reference ever reaches `refine`. Defaults are
 chosen by the edit means; the training view's numbers are printed beside them, not used.
 

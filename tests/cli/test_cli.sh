@@ -202,12 +202,13 @@ if [ -d "$shared/models/taesd3" ]; then
     for f in "$out/refs_before"/*; do check cmp "$f" "$out/refs/$(basename "$f")"; done
     check sh -c "! cmp -s '$out/refs/move_16x16_2spp_clip_frame_0001_own_seed.exr' '$out/refs/move_16x16_2spp_clip_frame_0001_own_seed_seed7.exr'"
     check sh -c "! cmp -s '$out/ed2/metrics.csv' '$out/ed2r/metrics.csv'"
-    # Each edited frame's reference has its own seed: two frames of one edited scene (the light
-    # held at its last keyframe) get different traces; one seed for both would give the same bytes.
-    printf '{"frames": 3, "shapes": [{"id": "light", "translate": [[0,0,0],[0.5,0,0],[0.5,0,0]]}]}' > "$out/hold.json"
+    # Each edited frame's reference has its own seed: three frames of one edited scene (the light
+    # moved by a constant) get different traces; one seed for all would give the same bytes.
+    printf '{"frames": 3, "shapes": [{"id": "light", "translate": [[0.5,0,0]]}]}' > "$out/hold.json"
     "$bin" render "$out/enc" --edit "$out/hold.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/hrefs" --out "$out/edh"
     check test -s "$out/hrefs/hold_16x16_2spp_clip_frame_0002_own_seed.exr"
     check sh -c "! cmp -s '$out/hrefs/hold_16x16_2spp_clip_frame_0001_own_seed.exr' '$out/hrefs/hold_16x16_2spp_clip_frame_0002_own_seed.exr'"
+    check sh -c "! cmp -s '$out/hrefs/hold_16x16_2spp_clip_frame_0000_own_seed.exr' '$out/hrefs/hold_16x16_2spp_clip_frame_0002_own_seed.exr'"
     # The workflow's chunk jobs (frames 0:0 and 1:1, each writing metrics_A-B.csv) merged by
     # experiment_lib.merge_metrics: byte for byte the one job's metrics.csv (issue 20).
     for r in 0:0 1:1; do
