@@ -38,15 +38,20 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
     return vae.encode(rgb, width, height);
 }
 
+namespace {
+/// "<W>x<H>_<spp>spp_<tone>": the part of every cache name that says how a reference was traced.
+std::string trace_settings_key(int width, int height, int spp, const std::string& tone) {
+    return std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) + "spp_" + tone;
+}
+}  // namespace
+
 std::string training_reference_key(int width, int height, int spp, const std::string& tone) {
-    return "training_" + std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) + "spp_" +
-           tone;
+    return "training_" + trace_settings_key(width, height, spp, tone);
 }
 
 std::string edited_frame_reference_key(const std::string& edits_stem, int width, int height, int spp,
                                        const std::string& tone, const std::string& frame_name) {
-    return edits_stem + "_" + std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) +
-           "spp_" + tone + "_" + frame_name + kEditedFrameSeedTag;
+    return edits_stem + "_" + trace_settings_key(width, height, spp, tone) + "_" + frame_name + kEditedFrameSeedTag;
 }
 
 uint64_t edited_frame_seed(uint64_t ref_seed, int frame) {

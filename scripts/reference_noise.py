@@ -18,8 +18,8 @@ independent of both references. On frame 0 r₁ is the training view's reference
 the refiner's target, whose noise a refiner reproduces in part: there only r₂ is independent of x,
 and MSE(x, r₂) − σ² is the unbiased estimate. Edited frames' references have had their own seeds
 since session 29 (docs/metrics.md); in folders made before, r₁ shared the target's seed on every
-frame, so where the camera held still its noise was partly the target's there too. LPIPS has no such identity: the script prints it against r₁, r₂ and their
-mean (twice the spp). The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ².
+frame, so where the camera held still its noise was partly the target's there too. LPIPS has no
+such identity: the script prints it against r₁, r₂ and their mean (twice the spp). The VAE round trip gets the same treatment: dec(enc(r₁)) against r₂, less σ².
 
     python3 scripts/reference_noise.py --scene-dir results-paper/cbox-specular --seed-dir noise_seed1
 
@@ -90,8 +90,8 @@ def reference_stem(refs, sequence, size, spp, frame, seed_suffix=""):
     if frame == 0:
         return os.path.join(refs, f"training_{size}x{size}_{spp}spp_clip{seed_suffix}")
     stem = os.path.join(refs, f"edits-{sequence}_{size}x{size}_{spp}spp_clip_frame_{frame:04d}")
-    own = f"{stem}_own_seed{seed_suffix}"
-    return own if os.path.exists(own + ".exr") or not os.path.exists(stem + seed_suffix + ".exr") else stem + seed_suffix
+    own, shared = f"{stem}_own_seed{seed_suffix}", stem + seed_suffix
+    return shared if os.path.exists(shared + ".exr") and not os.path.exists(own + ".exr") else own
 
 
 def frame_row(m, x_png, r1, r2, rbar, r12):

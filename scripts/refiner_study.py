@@ -6,9 +6,10 @@ the refiner removed) with `latentpt refine <options>`; each then renders the exp
 against the experiment's path-traced references (read from its reference cache, never traced
 again; an experiment folder made before session 29 lacks the edited frames' own-seed references,
 docs/metrics.md, so the first variant traces them, and rows of earlier runs kept in study.md
-were scored against the old ones: start such a study in a fresh folder) and reports the mean refined LPIPS / MSE×100 over the edited frames. Training uses the
-single training view only: no edited frame or its reference ever reaches `refine`. Defaults are
-chosen by the edit means; the training view's numbers are printed beside them, not used.
+were scored against the old ones: start such a study in a fresh folder) and reports the mean
+refined LPIPS / MSE×100 over the edited frames. Training uses the single training view only:
+no edited frame or its reference ever reaches `refine`. Defaults are chosen by the edit means;
+the training view's numbers are printed beside them, not used.
 
     python3 scripts/refiner_study.py --scene-dir results-paper/cbox-specular --variants mse_only,whole_view
 
