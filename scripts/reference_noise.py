@@ -87,9 +87,10 @@ def mean_png(a, b, png):
 def reference_stem(refs, sequence, size, spp, frame, seed_suffix=""):
     """A cached reference's path without .exr: the training view's for frame 0, else the edited
     frame's, traced with its own seed (`_own_seed`), or in folders made before that, with r₁'s."""
+    traced = f"{size}x{size}_{spp}spp_clip"  # how it was traced, as pipeline/reference.cpp names it
     if frame == 0:
-        return os.path.join(refs, f"training_{size}x{size}_{spp}spp_clip{seed_suffix}")
-    stem = os.path.join(refs, f"edits-{sequence}_{size}x{size}_{spp}spp_clip_frame_{frame:04d}")
+        return os.path.join(refs, f"training_{traced}{seed_suffix}")
+    stem = os.path.join(refs, f"edits-{sequence}_{traced}_frame_{frame:04d}")
     own, shared = f"{stem}_own_seed{seed_suffix}", stem + seed_suffix
     return shared if os.path.exists(shared + ".exr") and not os.path.exists(own + ".exr") else own
 
