@@ -12,8 +12,7 @@
 namespace lpt::app {
 namespace {
 
-/// A number that must be > 0 (strict) or >= 0; CLI11's own validators print their range as
-/// "0 to 1.8e308" in full.
+/// A number > 0 (strict) or >= 0; CLI11's own validators print their range as "0 to 1.8e308".
 CLI::Validator bounded_below(bool strict) {
     return CLI::Validator(
         [strict](std::string& text) -> std::string {
@@ -91,9 +90,10 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
                "what the refiner reads besides the AOVs: latent (the toned render) or terms (also its transport terms "
                "Ie, Ia, Ic before the tone curve; edits then render them too)");
     add_choice(sc, "--" + pre + "inference", ra.windowed_inference, "windows", "whole",
-               "how the trained refiner is applied: windows (the training crop's size, stride half of it, averaged; "
-               "InstanceNorm then sees what it saw in training) or whole (the whole view at once)",
+               "how the trained refiner is applied: windows (the training crop's size, overlapping, averaged; "
+               "InstanceNorm sees what it saw in training) or whole (the view at once)",
                true);
+    add_number(sc, "--" + pre + "window-stride", ra.window_stride, "latent pixels between windows", positive());
     add_number(sc, "--" + pre + "dropout", ra.net.dropout, "dropout after each block", CLI::Range(0.0, 0.99));
     add_number(sc, "--" + pre + "noise-views", ra.noise_views,
                "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone",

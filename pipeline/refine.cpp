@@ -98,6 +98,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
         {"augment", to_string(job.augment)},
         {"lr_decay", job.train.cosine_decay ? "cosine" : "none"},
         {"inference_window", refiner.config().tile},
+        {"inference_stride", refiner.config().tile > 0 ? inference_stride(refiner.config()) : 0},
         {"lpips_crop", job.train.lpips_crop},
         {"latent_target", job.compensated_target ? "compensated" : "encoded"}};
     if (job.latent_target_block) record["latent_target_block"] = job.latent_target_block;
@@ -234,6 +235,9 @@ void validate(const RefineJob& job) {
     require(t.iterations > 0, "iterations", "> 0", t.iterations);
     require(n.expansion > 0, "expansion", "> 0", n.expansion);
     require(t.crop >= 0, "crop", ">= 0", t.crop);
+    require(job.window_stride > 0, "window-stride", "> 0", job.window_stride);
+    require(t.crop == 0 || job.window_stride <= t.crop, "window-stride", "at most --crop (every pixel in a window)",
+            job.window_stride);
     require(t.lpips_crop >= 0, "lpips-crop", ">= 0", t.lpips_crop);
     require(t.lr > 0 && std::isfinite(t.lr), "lr", "> 0", t.lr);
     require(t.patience >= 0, "patience", ">= 0", t.patience);
@@ -264,6 +268,7 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     cfg.latent_channels = kLatentChannels;
     cfg.distance_scale = mean_hit_distance(in);
     cfg.tile = inference_window(job, in);
+    cfg.window_stride = cfg.tile > 0 ? job.window_stride : 0;
     auto refiner = Refiner::create(cfg, job.train.seed);
     RefinerTrainOptions o = job.train;
     o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();

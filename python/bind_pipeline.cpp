@@ -78,6 +78,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "inputs") n.terms = either(shown, value.cast<std::string>(), "terms", "latent");
     else if (k == "norm") n.instance_norm = either(shown, value.cast<std::string>(), "instance", "none");
     else if (k == "inference") job.windowed_inference = either(shown, value.cast<std::string>(), "windows", "whole");
+    else if (k == "window_stride") job.window_stride = value.cast<int>();
     else if (k == "dropout") n.dropout = value.cast<float>();
     else if (k == "noise_views") job.noise_views = value.cast<int>();
     else if (k == "augment") job.augment = pipeline::parse_refiner_augment(value.cast<std::string>());

@@ -37,6 +37,10 @@ struct RefinerConfig {
     /// (docs/refiner.md "Windows"). A view no larger than the window is one window: the whole view.
     /// Files written before the option hold none and load as 0.
     int tile = 0;
+    /// Latent pixels between neighbouring inference windows; 0 = tile / 2 (files written before
+    /// the option hold none). Denser windows average the output over more crop statistics
+    /// (docs/refiner.md "Windows"), at (tile / stride)² network passes per tile² pixels.
+    int window_stride = 0;
     /// Files written before the option hold none and load as conv.
     RefinerArch arch = RefinerArch::Conv;
     /// Also read the three transport terms Ĩe, Ĩa, Ĩc of the same render (linear, before the tone
@@ -45,6 +49,11 @@ struct RefinerConfig {
     /// before the option hold none and load as false.
     bool terms = false;
 };
+
+/// The stride refine() steps its windows by: window_stride, or half the window when that is 0.
+inline int inference_stride(const RefinerConfig& c) {
+    return c.window_stride > 0 ? c.window_stride : (c.tile / 2 > 0 ? c.tile / 2 : 1);
+}
 
 inline const char* to_string(RefinerArch arch) { return arch == RefinerArch::UNet ? "unet" : "conv"; }
 /// "conv" or "unet"; throws std::invalid_argument naming `option` otherwise. Inline: the

@@ -16,25 +16,24 @@ torch::nn::Conv2d conv(int64_t in, int64_t out, int64_t k) {
     return torch::nn::Conv2d(torch::nn::Conv2dOptions(in, out, k).padding(k / 2));
 }
 
-/// Origins of windows of `window` pixels along an axis of `size`: every window/2 pixels, and the
+/// Origins of windows of `window` pixels along an axis of `size`: every `stride` pixels, and the
 /// last one flush with the far edge, so that every pixel is covered.
-std::vector<int64_t> window_origins(int64_t size, int64_t window) {
+std::vector<int64_t> window_origins(int64_t size, int64_t window, int64_t stride) {
     std::vector<int64_t> origins;
-    const int64_t stride = std::max<int64_t>(1, window / 2);
     for (int64_t o = 0; o + window < size; o += stride) origins.push_back(o);
     origins.push_back(std::max<int64_t>(0, size - window));
     return origins;
 }
 
-/// The network on tile×tile windows of x (fewer pixels along an axis shorter than that), the
-/// outputs averaged where windows overlap. Windows go through in batches to bound memory; the
-/// sums run in a fixed order, so the result is deterministic.
-torch::Tensor forward_in_windows(RefinerNet& net, const torch::Tensor& x, int tile) {
+/// The network on tile×tile windows of x (fewer pixels along an axis shorter than that) every
+/// `stride` pixels, the outputs averaged where windows overlap. Windows go through in batches to
+/// bound memory; the sums run in a fixed order, so the result is deterministic.
+torch::Tensor forward_in_windows(RefinerNet& net, const torch::Tensor& x, int tile, int stride) {
     constexpr size_t kBatch = 32;
     const int64_t h = x.size(2), w = x.size(3), th = std::min<int64_t>(tile, h), tw = std::min<int64_t>(tile, w);
     std::vector<std::pair<int64_t, int64_t>> windows;
-    for (int64_t y : window_origins(h, th))
-        for (int64_t x0 : window_origins(w, tw)) windows.emplace_back(y, x0);
+    for (int64_t y : window_origins(h, th, std::min<int64_t>(stride, th)))  // a longer step would skip pixels
+        for (int64_t x0 : window_origins(w, tw, std::min<int64_t>(stride, tw))) windows.emplace_back(y, x0);
     torch::Tensor sum = torch::zeros({1, int64_t(net->cfg.latent_channels), h, w});
     torch::Tensor count = torch::zeros({1, 1, h, w});
     for (size_t first = 0; first < windows.size(); first += kBatch) {
@@ -164,7 +163,8 @@ std::vector<float> Refiner::refine(const RefinerInput& input) const {
     const torch::Tensor x = refiner_input_tensor(input, m->config);
     const int tile = m->config.tile;
     const bool one_window = tile <= 0 || (input.width <= tile && input.height <= tile);
-    return refiner_to_hwc(one_window ? m->net->forward(x) : forward_in_windows(m->net, x, tile));
+    if (one_window) return refiner_to_hwc(m->net->forward(x));
+    return refiner_to_hwc(forward_in_windows(m->net, x, tile, inference_stride(m->config)));
 }
 
 void Refiner::save(const std::string& path) const {
@@ -178,6 +178,7 @@ void Refiner::save(const std::string& path) const {
     ar.write("config.distance_scale", c10::IValue(double(c.distance_scale)));
     ar.write("config.instance_norm", c10::IValue(int64_t(c.instance_norm)));
     ar.write("config.tile", c10::IValue(int64_t(c.tile)));
+    if (c.window_stride > 0) ar.write("config.window_stride", c10::IValue(int64_t(c.window_stride)));  // else as before
     if (c.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(c.arch)));  // conv files as before
     if (c.terms) ar.write("config.terms", c10::IValue(int64_t(1)));  // files without terms as before
     const std::string tmp = path + ".tmp";
@@ -206,6 +207,8 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c.instance_norm = archived_instance_norm(ar);
         c10::IValue tile;
         c.tile = ar.try_read("config.tile", tile) ? int(tile.toInt()) : 0;  // older files: the whole view
+        c10::IValue stride;
+        c.window_stride = ar.try_read("config.window_stride", stride) ? int(stride.toInt()) : 0;  // older: tile / 2
         c.arch = archived_arch(ar);
         c.terms = archived_terms(ar);
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});

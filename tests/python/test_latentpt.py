@@ -314,7 +314,8 @@ class OneProcessTest(unittest.TestCase):
                               ({"iterations": 0}, "iterations"), ({"augment": "turn"}, "turn"),
                               ({"arch": "mlp"}, "arch"), ({"inputs": "rgb"}, "inputs"),
                               ({"latent_target": "decoded"}, "latent_target"),
-                              ({"latent_target_block": 16}, "latent-target-block")):
+                              ({"latent_target_block": 16}, "latent-target-block"),
+                              ({"window_stride": 0}, "window-stride")):
                 with self.assertRaises(ValueError) as e:
                     latentpt.refine(fit, note=lambda t: None, **bad)
                 self.assertIn(name, str(e.exception))

@@ -314,6 +314,34 @@ TEST(Refiner, WithoutInstanceNormACropIsRefinedAsTheWholeView) {
                               {"--norm instance"}, "an InstanceNorm checkpoint resumed without InstanceNorm");
 }
 
+/// The largest difference between `out` and the per-pixel mean of `windowed` applied to the
+/// side × side windows of `in` at the origins xs × ys, each window also checked against `whole`
+/// (the same training without windows).
+double distance_to_window_mean(const std::vector<float>& out, const Refiner& windowed, const Refiner& whole,
+                               const RefinerInput& in, int side, const std::vector<int>& xs,
+                               const std::vector<int>& ys) {
+    std::vector<double> sum(out.size(), 0.0), count(out.size(), 0.0);
+    for (int y0 : ys)
+        for (int x0 : xs) {
+            const RefinerInput window = crop_of(in, x0, y0, side, side);
+            const std::vector<float> part = windowed.refine(window);
+            EXPECT_EQ(part, whole.refine(window)) << "the window changed training, not just inference";
+            for (int y = 0; y < side; ++y)
+                for (int x = 0; x < side; ++x)
+                    for (int c = 0; c < kC; ++c) {
+                        const size_t i = (size_t(y0 + y) * size_t(in.width) + size_t(x0 + x)) * kC + size_t(c);
+                        sum[i] += part[(size_t(y) * size_t(side) + size_t(x)) * kC + size_t(c)];
+                        count[i] += 1.0;
+                    }
+        }
+    double worst = 0;
+    for (size_t i = 0; i < out.size(); ++i) {
+        EXPECT_GT(count[i], 0.0) << "pixel " << i / kC << " is in no window";
+        worst = std::max(worst, std::abs(out[i] - sum[i] / count[i]));
+    }
+    return worst;
+}
+
 // Windowed inference (RefinerConfig::tile, docs/refiner.md "Windows"): the refined view is, per
 // pixel, the mean of the refiner applied to every tile×tile window at stride tile/2, the last
 // window flush with the far edge; checked against those windows refined one by one, at origins
@@ -327,35 +355,46 @@ TEST(Refiner, WindowsAverageTheRefinedWindowsOfTheTrainingCropSize) {
     windowed->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
     whole->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
     const std::vector<float> out = windowed->refine(p.in);
-
-    const std::vector<int> xs = {0, 4, 8, 12, 13}, ys = {0, 4, 5};  // 21 and 13 pixels, windows of 8
-    std::vector<double> sum(out.size(), 0.0), count(out.size(), 0.0);
-    for (int y0 : ys)
-        for (int x0 : xs) {
-            const RefinerInput window = crop_of(p.in, x0, y0, 8, 8);
-            const std::vector<float> part = windowed->refine(window);
-            ASSERT_EQ(part, whole->refine(window)) << "the window changed training, not just inference";
-            for (int y = 0; y < 8; ++y)
-                for (int x = 0; x < 8; ++x)
-                    for (int c = 0; c < kC; ++c) {
-                        const size_t i = (size_t(y0 + y) * size_t(p.in.width) + size_t(x0 + x)) * kC + size_t(c);
-                        sum[i] += part[(size_t(y) * 8 + size_t(x)) * kC + size_t(c)];
-                        count[i] += 1.0;
-                    }
-        }
-    double worst = 0;
-    for (size_t i = 0; i < out.size(); ++i) {
-        ASSERT_GT(count[i], 0.0) << "pixel " << i / kC << " is in no window";
-        worst = std::max(worst, std::abs(out[i] - sum[i] / count[i]));
-    }
-    EXPECT_LT(worst, 1e-5);
+    // 21 and 13 pixels, windows of 8 every 4
+    EXPECT_LT(distance_to_window_mean(out, *windowed, *whole, p.in, 8, {0, 4, 8, 12, 13}, {0, 4, 5}), 1e-5);
     EXPECT_GT(mse(out, whole->refine(p.in)), 1e-8) << "windows gave the whole view's output";
 
     const std::string file = temp_path("windowed_refiner.pt");
     windowed->save(file);
     auto loaded = Refiner::load(file);
     EXPECT_EQ(loaded->config().tile, 8);
+    EXPECT_EQ(loaded->config().window_stride, 0) << "a file with the old rule must load with it";
     EXPECT_EQ(loaded->refine(p.in), out);
+}
+
+// RefinerConfig::window_stride: the same mean over windows at the stride it names (the last
+// window still flush with the far edge), a stride longer than a window shortened to it so that
+// no pixel is left out, and the stride kept in refiner.pt.
+TEST(Refiner, WindowStrideSetsTheWindowOrigins) {
+    Problem p = make_problem(21, 13);
+    RefinerConfig cfg = small();
+    cfg.tile = 8;
+    cfg.window_stride = 3;
+    auto windowed = Refiner::create(cfg, 5), whole = Refiner::create(small(), 5);
+    windowed->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
+    whole->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
+    const std::vector<float> out = windowed->refine(p.in);
+    EXPECT_LT(distance_to_window_mean(out, *windowed, *whole, p.in, 8, {0, 3, 6, 9, 12, 13}, {0, 3, 5}), 1e-5);
+    cfg.window_stride = 0;
+    auto halves = Refiner::create(cfg, 5);
+    halves->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
+    EXPECT_GT(mse(out, halves->refine(p.in)), 1e-10) << "stride 3 gave the stride-4 windows' output";
+
+    const std::string file = temp_path("strided_refiner.pt");
+    windowed->save(file);
+    auto loaded = Refiner::load(file);
+    EXPECT_EQ(loaded->config().window_stride, 3);
+    EXPECT_EQ(loaded->refine(p.in), out);
+
+    cfg.window_stride = 20;  // longer than the window: every 8 pixels, the last flush
+    auto sparse = Refiner::create(cfg, 5);
+    sparse->train(p.in, p.target, nullptr, nullptr, nullptr, latent_training(30, 8));
+    EXPECT_LT(distance_to_window_mean(sparse->refine(p.in), *sparse, *whole, p.in, 8, {0, 8, 13}, {0, 5}), 1e-5);
 }
 
 TEST(Refiner, LpipsThroughTheDecoderTrains) {
