@@ -100,9 +100,10 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
                positive());
     sc->add_option_function<std::string>(
           "--" + pre + "augment", [&ra](const std::string& v) { ra.augment = pipeline::parse_refiner_augment(v); },
-          "extra training views made from the training view alone: none, mirror (its mirror image) or dihedral "
-          "(also the camera rolled by quarter turns); each against its reference moved the same way and encoded")
-        ->check(CLI::IsMember({"none", "mirror", "dihedral"}))
+          "extra training views made from the training view alone: none, mirror (its mirror image), dihedral (also "
+          "the camera rolled by quarter turns) or shift (the film moved by half a latent pixel); each against its "
+          "reference moved the same way and encoded")
+        ->check(CLI::IsMember({"none", "mirror", "dihedral", "shift"}))
         ->default_str(pipeline::to_string(ra.augment));
     add_choice(sc, "--" + pre + "latent-target", ra.compensated_target, "compensated", "encoded",
                "the refiner's target: encoded (target.exr, the paper's) or compensated (the reference encoded with "

@@ -130,16 +130,22 @@ nlohmann::json judge(const fs::path& dir, const RefinerInput& in, const std::vec
 /// small seeds (fit seed + 1, edit seed + frame) that the fit's latent and edited frames use.
 uint64_t noise_view_seed(uint64_t fit_seed, int k) { return mix64(fit_seed ^ mix64(0x6e6f697365ull + uint64_t(k))); }
 
+/// The spp of the fit's latent.exr, which renders made again for `option` match.
+int fit_final_spp(const RefineJob& job, const FitFolder& fit, const std::string& option) {
+    const int spp = fit.manifest.value("stage1", nlohmann::json::object()).value("final_spp", 0);
+    if (spp <= 0)
+        throw std::runtime_error((fs::path(job.fitdir) / "fit.json").string() +
+                                 ": field 'stage1.final_spp' missing or not positive (needed for " + option + ")");
+    return spp;
+}
+
 /// The fit's own view first, then job.noise_views − 1 renders of the same camera with other seeds.
 std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit, RefinerInput fit_view,
                                       const Reporter& report) {
     std::vector<RefinerInput> views;
     views.push_back(std::move(fit_view));
     if (job.noise_views <= 1) return views;
-    const int spp = fit.manifest.value("stage1", nlohmann::json::object()).value("final_spp", 0);
-    if (spp <= 0)
-        throw std::runtime_error((fs::path(job.fitdir) / "fit.json").string() +
-                                 ": field 'stage1.final_spp' missing or not positive (needed for --noise-views)");
+    const int spp = fit_final_spp(job, fit, "--noise-views");
     const uint64_t fit_seed = fit.manifest.value("seed", uint64_t(0));
     report.say("[refine] rendering " + std::to_string(job.noise_views - 1) + " more views of the training view at " +
                std::to_string(spp) + " spp");
@@ -172,6 +178,41 @@ std::vector<float> latent_target(const RefineJob& job, const Vae& vae, const std
     return encode_compensated(vae, rgb, width, height, block);
 }
 
+/// Puts the fit's scene camera back when a scope ends, however it ends.
+struct CameraRestore {
+    Scene& scene;
+    Camera saved;
+    explicit CameraRestore(Scene& s) : scene(s), saved(s.camera) {}
+    ~CameraRestore() { scene.camera = saved; }
+};
+
+/// job.augment shift: the training view rendered again through the film moved by each of
+/// film_shifts() (seeds of their own, the fit's final spp), cropped to the latent cells the
+/// reference covers, against the reference moved the same way and encoded.
+void add_film_shift_examples(const RefineJob& job, const FitFolder& fit, const Judges& judges, int w, int h,
+                             std::vector<RefinerExample>& examples, const Reporter& report) {
+    require_reference(job, judges, "--refiner-augment shift");
+    const int spp = fit_final_spp(job, fit, "--refiner-augment shift");
+    const uint64_t fit_seed = fit.manifest.value("seed", uint64_t(0));
+    const std::vector<FilmShift> shifts = film_shifts();
+    report.say("[refine] " + std::to_string(shifts.size()) +
+               " augmented views (shift): the film moved by half a latent pixel, rendered and their references "
+               "encoded");
+    for (size_t i = 0; i < shifts.size(); ++i) {
+        const FilmShift s = shifts[i];
+        const int cw = w - (s.x > 0 ? 1 : 0), ch = h - (s.y > 0 ? 1 : 0);
+        RefinerInput view;
+        {
+            const CameraRestore restore(*fit.scene);
+            fit.scene->camera = film_shifted(restore.saved, float(s.x) / float(8 * w), float(s.y) / float(8 * h));
+            view = fit_refiner_view(fit, job.net, w, h, spp, noise_view_seed(fit_seed, 1000 + int(i)));
+        }
+        std::vector<float> rgb = crop_image(judges.ref_rgb, 8 * w, 3, s.x, s.y, 8 * cw, 8 * ch);
+        std::vector<float> target = latent_target(job, *judges.vae, rgb, 8 * cw, 8 * ch);
+        examples.push_back({crop_view(view, 0, 0, cw, ch), std::move(target), std::move(rgb)});
+    }
+}
+
 /// The training examples: every noise view against the target (target.exr, or with
 /// job.compensated_target the reference's compensated encoding), then (job.augment) every noise
 /// view moved by each other transform, against the reference image moved the same way and
@@ -188,6 +229,10 @@ std::vector<RefinerExample> training_examples(const RefineJob& job, const FitFol
     }
     std::vector<RefinerExample> examples;
     for (const RefinerInput& v : views) examples.push_back({v, view_target, judges.ref_rgb});
+    if (job.augment == RefinerAugment::Shift) {
+        add_film_shift_examples(job, fit, judges, target.width, target.height, examples, report);
+        return examples;
+    }
     const std::vector<ViewTransform> moves = augment_transforms(job.augment);
     if (moves.size() == 1) return examples;
     require_reference(job, judges, "--refiner-augment " + to_string(job.augment));

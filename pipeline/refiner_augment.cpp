@@ -7,7 +7,8 @@ RefinerAugment parse_refiner_augment(const std::string& name) {
     if (name == "none") return RefinerAugment::None;
     if (name == "mirror") return RefinerAugment::Mirror;
     if (name == "dihedral") return RefinerAugment::Dihedral;
-    throw std::invalid_argument("refiner augmentation '" + name + "': expected none, mirror or dihedral");
+    if (name == "shift") return RefinerAugment::Shift;
+    throw std::invalid_argument("refiner augmentation '" + name + "': expected none, mirror, dihedral or shift");
 }
 
 std::string to_string(RefinerAugment a) {
@@ -16,6 +17,8 @@ std::string to_string(RefinerAugment a) {
             return "mirror";
         case RefinerAugment::Dihedral:
             return "dihedral";
+        case RefinerAugment::Shift:
+            return "shift";
         default:
             return "none";
     }
@@ -23,7 +26,7 @@ std::string to_string(RefinerAugment a) {
 
 std::vector<ViewTransform> augment_transforms(RefinerAugment a) {
     std::vector<ViewTransform> ts = {{0, false}};
-    if (a == RefinerAugment::None) return ts;
+    if (a == RefinerAugment::None || a == RefinerAugment::Shift) return ts;
     ts.push_back({0, true});
     if (a == RefinerAugment::Mirror) return ts;
     for (int turns = 1; turns < 4; ++turns)
@@ -86,5 +89,45 @@ RefinerInput transform_view(const RefinerInput& in, ViewTransform t, const Vec3f
 }
 
 Vec3f mirror_plane_normal(const Camera& camera) { return camera.world_from_camera.vector(Vec3f::UnitX()).normalized(); }
+
+std::vector<FilmShift> film_shifts() { return {{4, 0}, {0, 4}, {4, 4}}; }
+
+Camera film_shifted(const Camera& c, float fx, float fy) {
+    // Film position (px, py) looks along camera-space ((1 − 2 px / W) tx, (1 − 2 py / H) ty, 1)
+    // (core/cameras/perspective.cpp); moving it by (fx W, fy H) adds (−2 fx tx, −2 fy ty) to that
+    // direction's x and y per unit of z.
+    const Vec2f t = c.tan_half_fov();
+    Eigen::Matrix4f shear = Eigen::Matrix4f::Identity();
+    shear(0, 2) = -2.f * fx * t.x();
+    shear(1, 2) = -2.f * fy * t.y();
+    Camera moved = c;
+    moved.world_from_camera = c.world_from_camera * Transform(shear);
+    return moved;
+}
+
+std::vector<float> crop_image(const std::vector<float>& image, int width, int c, int x0, int y0, int w, int h) {
+    const int height = width > 0 && c > 0 ? int(image.size() / (size_t(width) * size_t(c))) : 0;
+    if (x0 < 0 || y0 < 0 || w < 0 || h < 0 || x0 + w > width || y0 + h > height)
+        throw std::invalid_argument("crop_image: window outside the image");
+    std::vector<float> out;
+    out.reserve(size_t(w) * size_t(h) * size_t(c));
+    for (int y = y0; y < y0 + h; ++y) {
+        const auto row = image.begin() + std::ptrdiff_t((size_t(y) * size_t(width) + size_t(x0)) * size_t(c));
+        out.insert(out.end(), row, row + std::ptrdiff_t(size_t(w) * size_t(c)));
+    }
+    return out;
+}
+
+RefinerInput crop_view(const RefinerInput& in, int x0, int y0, int w, int h) {
+    RefinerInput out;
+    out.width = w;
+    out.height = h;
+    const size_t pixels = size_t(in.width) * size_t(in.height);
+    out.latent = crop_image(in.latent, in.width, int(in.latent.size() / pixels), x0, y0, w, h);
+    out.normal = crop_image(in.normal, in.width, 3, x0, y0, w, h);
+    out.distance = crop_image(in.distance, in.width, 1, x0, y0, w, h);
+    if (!in.terms.empty()) out.terms = crop_image(in.terms, in.width, int(in.terms.size() / pixels), x0, y0, w, h);
+    return out;
+}
 
 }  // namespace lpt::pipeline

@@ -136,6 +136,8 @@ if [ -d "$shared/models/taesd3" ]; then
     cp -r "$out/enc" "$out/enc_aug"
     "$bin" refine "$out/enc_aug" --iterations 6 --expansion 1 -q --augment dihedral
     check grep -q '"augment": "dihedral"' "$out/enc_aug/metrics.json"
+    "$bin" refine "$out/enc_aug" --iterations 6 --expansion 1 -q --augment shift --latent-target compensated
+    check grep -q '"augment": "shift"' "$out/enc_aug/metrics.json"
     expect_error "augment" "$bin" refine "$out/enc_aug" -q --augment flip
     # The compensated latent target: trained, recorded; refused without the fit's RGB reference.
     cp -r "$out/enc" "$out/enc_comp"

@@ -169,3 +169,48 @@ TEST(RefinerAugment, RolledCameraAndMirroredWorldRenderTheMovedViews) {
     const RefinerInput unreflected = transform_view(view, {0, true}, Vec3f::Zero());
     EXPECT_GT(mean_abs(unreflected.normal, mirror.normal), 0.1);
 }
+
+TEST(RefinerAugment, CropsTakeTheWindowWrittenByHand) {
+    // 3 × 2, two channels:  (0,1) (2,3) (4,5)
+    //                       (6,7) (8,9) (10,11)
+    const std::vector<float> img = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};
+    EXPECT_EQ(pipeline::crop_image(img, 3, 2, 1, 0, 2, 2), (std::vector<float>{2, 3, 4, 5, 8, 9, 10, 11}));
+    EXPECT_EQ(pipeline::crop_image(img, 3, 2, 0, 1, 1, 1), (std::vector<float>{6, 7}));
+    EXPECT_THROW(pipeline::crop_image(img, 3, 2, 2, 0, 2, 1), std::invalid_argument);
+    RefinerInput in;
+    in.width = 3;
+    in.height = 2;
+    in.latent = img;
+    in.normal.assign(18, 0.f);
+    in.distance = {1, 2, 3, 4, 5, 6};
+    const RefinerInput c = pipeline::crop_view(in, 1, 1, 2, 1);
+    EXPECT_EQ(c.width, 2);
+    EXPECT_EQ(c.height, 1);
+    EXPECT_EQ(c.latent, (std::vector<float>{8, 9, 10, 11}));
+    EXPECT_EQ(c.distance, (std::vector<float>{5, 6}));
+    EXPECT_EQ(c.normal.size(), 6u);
+}
+
+// The shift augmentation's camera: its film moved by one pixel's width (or height) renders, at
+// pixel (i, j), what the unmoved camera renders at (i + 1, j) (or (i, j + 1)), within sampling
+// noise, and not what it renders one pixel the other way. Distances and normals are compared: the
+// ray origin is kept, so the depth of each pixel is the same ray's.
+TEST(RefinerAugment, FilmShiftRendersTheViewMovedByWholePixels) {
+    const int n = 24;
+    Scene scene = load_scene(kCornell);
+    const RefinerInput view = aov_view(scene, n, n);
+    for (int axis = 0; axis < 2; ++axis) {
+        Scene moved = load_scene(kCornell);
+        moved.camera = pipeline::film_shifted(moved.camera, axis == 0 ? 1.f / n : 0.f, axis == 1 ? 1.f / n : 0.f);
+        const RefinerInput shifted = aov_view(moved, n, n);
+        const int dx = axis == 0 ? 1 : 0, dy = axis == 1 ? 1 : 0;
+        // the moved film's pixels 0 … n − 2 against the unmoved one's 1 … n − 1, and 0 … n − 2 (wrong way)
+        const RefinerInput a = pipeline::crop_view(shifted, 0, 0, n - dx, n - dy);
+        const RefinerInput ahead = pipeline::crop_view(view, dx, dy, n - dx, n - dy);
+        const RefinerInput same = pipeline::crop_view(view, 0, 0, n - dx, n - dy);
+        const double match = mean_abs(a.distance, ahead.distance) + mean_abs(a.normal, ahead.normal);
+        const double stay = mean_abs(a.distance, same.distance) + mean_abs(a.normal, same.normal);
+        EXPECT_LT(match, 0.03) << "axis " << axis;
+        EXPECT_GT(stay, 3 * match) << "axis " << axis << ": the moved film renders the unmoved view";
+    }
+}
