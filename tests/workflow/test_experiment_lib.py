@@ -71,6 +71,17 @@ class Preset(unittest.TestCase):
         c = X.settings(paper=True, refiner_latent_target="encoded")
         self.assertNotIn("--refiner-latent-target", X.fit_command(c, "cbox-specular", "eac", 2))
 
+    def test_dropout_only_on_the_refined_fit_and_only_when_set(self):
+        paper = X.settings(paper=True)
+        self.assertIn("--refiner-dropout 0.0", X.fit_command(paper, "cbox-specular", "eac", 2))  # the preset's
+        self.assertNotIn("--refiner-dropout", X.fit_command(paper, "cbox-specular", "ea", 2))  # no refiner
+        self.assertNotIn("--refiner-dropout", X.training_reference_command(paper, "cbox-specular", 2))
+        # unset: the fit's own default, not named, so the commands (and cached jobs) of other runs stay
+        self.assertNotIn("--refiner-dropout", X.fit_command(X.settings(), "cbox-specular", "eac", 2))
+        self.assertIsNone(X.settings()["refiner_dropout"])
+        c = X.settings(paper=True, refiner_dropout=0.1)  # an explicit value wins over the preset's
+        self.assertIn("--refiner-dropout 0.1", X.fit_command(c, "cbox-specular", "eac", 2))
+
     def test_training_reference_is_a_one_iteration_fit_into_refs(self):
         cmd = X.training_reference_command(X.settings(paper=True), "cbox-specular", 2)
         for part in ("--iterations 1 ", "--reference-cache cbox-specular/refs", "--no-refiner", "--encode-res 1024x1024"):
