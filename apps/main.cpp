@@ -95,6 +95,8 @@ void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std::string
                true);
     add_number(sc, "--" + pre + "window-stride", ra.window_stride, "latent pixels between windows", positive());
     add_number(sc, "--" + pre + "dropout", ra.net.dropout, "dropout after each block", CLI::Range(0.0, 0.99));
+    add_number(sc, "--" + pre + "emitter-cells", ra.net.emitter_cells,
+               "also read each latent pixel's emitter coverage in N x N sub-cells (0 = no)", CLI::Range(0, 8));
     add_number(sc, "--" + pre + "noise-views", ra.noise_views,
                "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone",
                positive());
@@ -150,9 +152,8 @@ struct Cli {
             ->check(positive());
         render
             ->add_option("--ref-seed", r.ref_seed,
-                         "with --reference: the references' seed (each edited frame traces with a seed made from "
-                         "it and the frame's index); another one traces independent references of the same frames "
-                         "(cached under their own names), e.g. to measure their noise")
+                         "with --reference: the references' seed (each edited frame's is made from it and the frame's "
+                         "index); another traces independent references (cached apart), e.g. to measure their noise")
             ->capture_default_str();
         render->add_option("--reference-cache", r.reference_cache,
                            "with --reference: keep path-traced frames in this folder and reuse them "
@@ -174,8 +175,7 @@ struct Cli {
             ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
             ->capture_default_str();
         render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr");
-        render->add_option("--aov-res", r.aov_res,
-                           "AOV resolution WxH (default: the image's; e.g. image/8 for latents)");
+        render->add_option("--aov-res", r.aov_res, "AOV resolution WxH (default: the image's; latents: image/8)");
         render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")->capture_default_str();
         render->add_option("-D,--define", defines, "override a scene value, e.g. -D integrator.max_depth=4");
         render->add_flag("-q,--quiet", r.quiet, "no progress line");

@@ -46,4 +46,26 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
     return out;
 }
 
+std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side) {
+    Camera camera = scene.camera.with_resolution(width, height);
+    const int k = cells * cells, n = rays_per_side;
+    std::vector<float> out(size_t(width) * height * k, 0.f);
+    tbb::parallel_for(0, height, [&](int y) {
+        set_ftz_daz();
+        for (int x = 0; x < width; ++x)
+            for (int cy = 0; cy < cells; ++cy)
+                for (int cx = 0; cx < cells; ++cx) {
+                    int hits = 0;
+                    for (int j = 0; j < n; ++j)
+                        for (int i = 0; i < n; ++i) {
+                            Vec2f film(x + (cx + (i + 0.5f) / n) / cells, y + (cy + (j + 0.5f) / n) / cells);
+                            SurfaceInteraction si = scene.intersect(camera.generate_ray(film));
+                            hits += si.valid() && scene.shapes[si.shape].emitter >= 0;
+                        }
+                    out[(size_t(y) * width + x) * k + cy * cells + cx] = float(hits) / float(n * n);
+                }
+    });
+    return out;
+}
+
 }  // namespace lpt

@@ -18,4 +18,12 @@ struct AovImages {
 AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height, int spp, uint64_t seed,
                       SamplerKind sampler = SamplerKind::Sobol);
 
+/// Where emitters lie inside each pixel: the pixel split into cells × cells sub-cells, each the
+/// fraction of its area whose camera ray first hits an emissive shape, from a regular grid of
+/// rays_per_side² rays per sub-cell (deterministic: coverage is geometry, not light). The
+/// refiner reads it because a pixel's average coverage says how much of it an emitter covers
+/// but not where its edge runs, which the VAE's encoding of a sharp edge depends on
+/// (docs/refiner.md "Emitter cells"). width × height × cells² values, sub-cells row-major.
+std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side = 4);
+
 }  // namespace lpt

@@ -115,6 +115,7 @@ nlohmann::json stage2_settings(const RefineJob& job) {
     if (t.cosine_decay) s["iterations"] = t.iterations;
     if (job.net.arch != RefinerArch::Conv) s["arch"] = to_string(job.net.arch);  // older checkpoints resume
     if (job.net.terms) s["inputs"] = "terms";
+    if (job.net.emitter_cells) s["emitter_cells"] = job.net.emitter_cells;
     if (job.compensated_target) s["latent_target"] = "compensated";
     if (job.latent_target_block) s["latent_target_block"] = job.latent_target_block;
     return s;

@@ -2,6 +2,7 @@
 #include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "core/sampler.h"
+#include "integrators/aov.h"
 #include "latent/latent.h"
 #include "pipeline/fit_checkpoint.h"
 #include "pipeline/fit_folder.h"
@@ -104,6 +105,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
     if (job.latent_target_block) record["latent_target_block"] = job.latent_target_block;
     if (refiner.config().arch != RefinerArch::Conv) record["arch"] = to_string(refiner.config().arch);
     if (refiner.config().terms) record["inputs"] = "terms";
+    if (refiner.config().emitter_cells) record["emitter_cells"] = refiner.config().emitter_cells;
     return record;
 }
 
@@ -139,6 +141,9 @@ int fit_final_spp(const RefineJob& job, const FitFolder& fit, const std::string&
     return spp;
 }
 
+/// The seed stage 1 ran with (fit.json); extra training views take seeds made from it.
+uint64_t fit_seed(const FitFolder& fit) { return fit.manifest.value("seed", uint64_t(0)); }
+
 /// The fit's own view first, then job.noise_views − 1 renders of the same camera with other seeds.
 std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit, RefinerInput fit_view,
                                       const Reporter& report) {
@@ -146,12 +151,11 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit
     views.push_back(std::move(fit_view));
     if (job.noise_views <= 1) return views;
     const int spp = fit_final_spp(job, fit, "--noise-views");
-    const uint64_t fit_seed = fit.manifest.value("seed", uint64_t(0));
     report.say("[refine] rendering " + std::to_string(job.noise_views - 1) + " more views of the training view at " +
                std::to_string(spp) + " spp");
     const int w = views[0].width, h = views[0].height;
     for (int k = 1; k < job.noise_views; ++k) {
-        const uint64_t seed = noise_view_seed(fit_seed, k);
+        const uint64_t seed = noise_view_seed(fit_seed(fit), k);
         views.push_back(fit_refiner_view(fit, job.net, w, h, spp, seed));
     }
     return views;
@@ -193,7 +197,6 @@ void add_film_shift_examples(const RefineJob& job, const FitFolder& fit, const J
                              std::vector<RefinerExample>& examples, const Reporter& report) {
     require_reference(job, judges, "--refiner-augment shift");
     const int spp = fit_final_spp(job, fit, "--refiner-augment shift");
-    const uint64_t fit_seed = fit.manifest.value("seed", uint64_t(0));
     const std::vector<FilmShift> shifts = film_shifts();
     report.say("[refine] " + std::to_string(shifts.size()) +
                " augmented views (shift): the film moved by half a latent pixel, rendered and their references "
@@ -205,7 +208,7 @@ void add_film_shift_examples(const RefineJob& job, const FitFolder& fit, const J
         {
             const CameraRestore restore(*fit.scene);
             fit.scene->camera = film_shifted(restore.saved, float(s.x) / float(8 * w), float(s.y) / float(8 * h));
-            view = fit_refiner_view(fit, job.net, w, h, spp, noise_view_seed(fit_seed, 1000 + int(i)));
+            view = fit_refiner_view(fit, job.net, w, h, spp, noise_view_seed(fit_seed(fit), 1000 + int(i)));
         }
         std::vector<float> rgb = crop_image(judges.ref_rgb, 8 * w, 3, s.x, s.y, 8 * cw, 8 * ch);
         std::vector<float> target = latent_target(job, *judges.vae, rgb, 8 * cw, 8 * ch);
@@ -292,6 +295,10 @@ void validate(const RefineJob& job) {
     require(n.squash > 0 && std::isfinite(n.squash), "squash", "> 0", n.squash);
     require(n.dropout >= 0 && n.dropout <= 0.99f, "dropout", "in [0, 0.99]", n.dropout);
     require(job.noise_views > 0, "noise-views", "> 0", job.noise_views);
+    require(n.emitter_cells >= 0 && n.emitter_cells <= 8, "emitter-cells", "in [0, 8]", n.emitter_cells);
+    // transform_view would have to reorder the sub-cells inside each pixel; shift renders them anew
+    require(n.emitter_cells == 0 || job.augment == RefinerAugment::None || job.augment == RefinerAugment::Shift,
+            "emitter-cells", "0 with --augment mirror or dihedral", n.emitter_cells);
     require(t.checkpoint_every >= 0, "checkpoint-every", ">= 0", t.checkpoint_every);
     require(job.latent_target_block >= 0, "latent-target-block", ">= 0", job.latent_target_block);
     require(job.latent_target_block == 0 || job.compensated_target, "latent-target-block",
@@ -337,9 +344,11 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
         return !cancelled;
     };
     RefineSummary s;
-    // The fitted scene (a load of the scene and its BVH) only when extra views need it.
-    const bool needs_fit = job.noise_views > 1 || job.augment != RefinerAugment::None;
+    // The fitted scene (a load of the scene and its BVH) only when extra views or emitter cells need it.
+    const bool needs_fit = job.noise_views > 1 || job.augment != RefinerAugment::None || job.net.emitter_cells > 0;
     const FitFolder fit = needs_fit ? load_fit_folder(job.fitdir, {}, job.sampler) : FitFolder{};
+    if (job.net.emitter_cells)
+        in.emitter = render_emitter_cells(*fit.scene, in.width, in.height, job.net.emitter_cells);
     const std::vector<RefinerExample> examples =
         training_examples(job, fit, noise_views(job, fit, in, report), target, judges, report);
     if (examples.size() > 1 && o.patience > 0)

@@ -127,6 +127,8 @@ RefinerInput crop_view(const RefinerInput& in, int x0, int y0, int w, int h) {
     out.normal = crop_image(in.normal, in.width, 3, x0, y0, w, h);
     out.distance = crop_image(in.distance, in.width, 1, x0, y0, w, h);
     if (!in.terms.empty()) out.terms = crop_image(in.terms, in.width, int(in.terms.size() / pixels), x0, y0, w, h);
+    if (!in.emitter.empty())
+        out.emitter = crop_image(in.emitter, in.width, int(in.emitter.size() / pixels), x0, y0, w, h);
     return out;
 }
 

@@ -21,10 +21,15 @@ RefinerInput refiner_view(const Scene& scene, std::vector<float> latent, int w, 
 }
 
 RefinerInput fit_refiner_view(const FitFolder& fit, const RefinerConfig& config, int w, int h, int spp, uint64_t seed) {
-    if (!config.terms) return refiner_view(*fit.scene, render_fit_latent(fit, w, h, spp, seed), w, h, spp, seed);
-    FitRender r = render_fit_terms(fit, w, h, spp, seed);
-    RefinerInput in = refiner_view(*fit.scene, std::move(r.toned), w, h, spp, seed);
-    in.terms = std::move(r.terms);
+    RefinerInput in;
+    if (config.terms) {
+        FitRender r = render_fit_terms(fit, w, h, spp, seed);
+        in = refiner_view(*fit.scene, std::move(r.toned), w, h, spp, seed);
+        in.terms = std::move(r.terms);
+    } else {
+        in = refiner_view(*fit.scene, render_fit_latent(fit, w, h, spp, seed), w, h, spp, seed);
+    }
+    if (config.emitter_cells) in.emitter = render_emitter_cells(*fit.scene, w, h, config.emitter_cells);
     return in;
 }
 

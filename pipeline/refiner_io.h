@@ -21,7 +21,8 @@ namespace lpt::pipeline {
 RefinerInput refiner_view(const Scene& scene, std::vector<float> latent, int w, int h, int spp, uint64_t seed);
 /// What a refiner with `config` reads of a fit's (possibly edited) scene rendered at w × h, spp
 /// and seed: the toned latent (render_fit_latent's), its AOVs, and the transport terms when
-/// config.terms (one render: the terms sum to the latent before its tone curve).
+/// config.terms (one render: the terms sum to the latent before its tone curve), and the emitter
+/// cells when config.emitter_cells.
 RefinerInput fit_refiner_view(const FitFolder& fit, const RefinerConfig& config, int w, int h, int spp, uint64_t seed);
 void write_refiner_aovs(const std::string& path, const RefinerInput& in);
 /// Throws naming the file when either is missing or has the wrong size or channels.

@@ -76,6 +76,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "squash") n.squash = value.cast<float>();
     else if (k == "arch") n.arch = parse_refiner_arch(value.cast<std::string>(), shown);
     else if (k == "inputs") n.terms = either(shown, value.cast<std::string>(), "terms", "latent");
+    else if (k == "emitter_cells") n.emitter_cells = value.cast<int>();
     else if (k == "norm") n.instance_norm = either(shown, value.cast<std::string>(), "instance", "none");
     else if (k == "inference") job.windowed_inference = either(shown, value.cast<std::string>(), "windows", "whole");
     else if (k == "window_stride") job.window_stride = value.cast<int>();

@@ -4,6 +4,7 @@
 // from the top-left, like films and vae.h. libtorch stays inside refiner/*.cpp. docs/refiner.md
 // gives the architecture, the loss and the measured quality/time trade-offs.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -48,11 +49,14 @@ struct RefinerConfig {
     /// the flat response, which the sum mixes (docs/refiner.md "Transport terms"). Files written
     /// before the option hold none and load as false.
     bool terms = false;
+    /// Also read where emitters lie inside each pixel: emitter coverage of cells × cells sub-cells
+    /// (RefinerInput::emitter; 0 = none). Files written before the option hold none and load as 0.
+    int emitter_cells = 0;
 };
 
 /// The stride refine() steps its windows by: window_stride, or half the window when that is 0.
 inline int inference_stride(const RefinerConfig& c) {
-    return c.window_stride > 0 ? c.window_stride : (c.tile / 2 > 0 ? c.tile / 2 : 1);
+    return c.window_stride > 0 ? c.window_stride : std::max(1, c.tile / 2);
 }
 
 inline const char* to_string(RefinerArch arch) { return arch == RefinerArch::UNet ? "unet" : "conv"; }
@@ -73,6 +77,9 @@ struct RefinerInput {
     /// width × height × 3·latent_channels: Ĩe, Ĩa, Ĩc of each pixel in turn (linear); read only by
     /// refiners with RefinerConfig::terms, empty otherwise.
     std::vector<float> terms;
+    /// width × height × emitter_cells²: each sub-cell's emitter coverage (render_emitter_cells);
+    /// read only by refiners with RefinerConfig::emitter_cells, empty otherwise.
+    std::vector<float> emitter;
 };
 
 /// One training pair: a render of a view and what it should refine to.

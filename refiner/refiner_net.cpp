@@ -106,8 +106,14 @@ bool archived_terms(torch::serialize::InputArchive& ar) {
     return ar.try_read("config.terms", terms) && terms.toInt() != 0;
 }
 
+int archived_emitter_cells(torch::serialize::InputArchive& ar) {
+    c10::IValue cells;
+    return ar.try_read("config.emitter_cells", cells) ? int(cells.toInt()) : 0;
+}
+
 int64_t refiner_input_channels(const RefinerConfig& config) {
-    return int64_t(config.latent_channels) * (config.terms ? 4 : 1) + kRefinerAovChannels;
+    return int64_t(config.latent_channels) * (config.terms ? 4 : 1) + kRefinerAovChannels +
+           int64_t(config.emitter_cells) * config.emitter_cells;
 }
 
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config) {
@@ -121,12 +127,19 @@ torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& 
                                     std::to_string(h) + " view needs " + std::to_string(3 * c) +
                                     " term channels per pixel (Ĩe, Ĩa, Ĩc), got " + std::to_string(in.terms.size()) +
                                     " values");
+    const int64_t cells = int64_t(config.emitter_cells) * config.emitter_cells;
+    if (cells && int64_t(in.emitter.size()) != n * cells)
+        throw std::invalid_argument("refiner: this refiner reads emitter cells: a " + std::to_string(w) + "x" +
+                                    std::to_string(h) + " view needs " + std::to_string(cells) +
+                                    " emitter coverage channels per pixel, got " + std::to_string(in.emitter.size()) +
+                                    " values");
     auto nchw = [&](const std::vector<float>& v, int64_t ch) {
         return torch::from_blob(const_cast<float*>(v.data()), {1, h, w, ch}).permute({0, 3, 1, 2});
     };
     std::vector<torch::Tensor> parts = {nchw(in.latent, c), nchw(in.normal, 3),
                                         nchw(in.distance, 1) / config.distance_scale};
     if (config.terms) parts.push_back(nchw(in.terms, 3 * c));
+    if (cells) parts.push_back(nchw(in.emitter, cells));
     return torch::cat(parts, 1).contiguous();
 }
 
@@ -181,6 +194,7 @@ void Refiner::save(const std::string& path) const {
     if (c.window_stride > 0) ar.write("config.window_stride", c10::IValue(int64_t(c.window_stride)));  // else as before
     if (c.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(c.arch)));  // conv files as before
     if (c.terms) ar.write("config.terms", c10::IValue(int64_t(1)));  // files without terms as before
+    if (c.emitter_cells) ar.write("config.emitter_cells", c10::IValue(int64_t(c.emitter_cells)));  // else as before
     const std::string tmp = path + ".tmp";
     ar.save_to(tmp);
     std::filesystem::rename(tmp, path);
@@ -211,6 +225,7 @@ std::unique_ptr<Refiner> Refiner::load(const std::string& path) {
         c.window_stride = ar.try_read("config.window_stride", stride) ? int(stride.toInt()) : 0;  // older: tile / 2
         c.arch = archived_arch(ar);
         c.terms = archived_terms(ar);
+        c.emitter_cells = archived_emitter_cells(ar);
         auto impl = std::make_unique<Impl>(Impl{c, RefinerNet(c)});
         impl->net->load(ar);
         return std::unique_ptr<Refiner>(new Refiner(std::move(impl)));

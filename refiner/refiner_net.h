@@ -30,7 +30,8 @@ struct Refiner::Impl {
 };
 
 constexpr int kRefinerAovChannels = 4;  ///< normal (3) + distance (1)
-/// Input channels of a network with `config`: latent, AOVs, and with config.terms Ĩe, Ĩa, Ĩc.
+/// Input channels of a network with `config`: latent, AOVs, with config.terms Ĩe, Ĩa, Ĩc, and
+/// with config.emitter_cells the sub-cells' emitter coverage.
 int64_t refiner_input_channels(const RefinerConfig& config);
 
 /// The instance_norm flag stored in a refiner.pt or checkpoint archive; files written before the
@@ -40,6 +41,8 @@ bool archived_instance_norm(torch::serialize::InputArchive& ar);
 RefinerArch archived_arch(torch::serialize::InputArchive& ar);
 /// The terms flag stored in an archive; files written before the option read no terms.
 bool archived_terms(torch::serialize::InputArchive& ar);
+/// The emitter cells stored in an archive; files written before the option read 0.
+int archived_emitter_cells(torch::serialize::InputArchive& ar);
 
 /// The network input [1, refiner_input_channels, h, w] of a view (distance divided by
 /// config.distance_scale; the terms appended when config.terms).

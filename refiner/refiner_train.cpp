@@ -71,6 +71,10 @@ void check_checkpoint_network(const std::string& path, torch::serialize::InputAr
     if (terms != cfg.terms)
         throw std::runtime_error(path + ": the checkpoint was trained with --inputs " + (terms ? "terms" : "latent") +
                                  "; resume with the same --inputs, or start again without --resume");
+    const int cells = archived_emitter_cells(ar);
+    if (cells != cfg.emitter_cells)
+        throw std::runtime_error(path + ": the checkpoint was trained with --emitter-cells " + std::to_string(cells) +
+                                 "; resume with the same --emitter-cells, or start again without --resume");
     c10::IValue v;
     if (ar.try_read("config.expansion", v) && v.toInt() != cfg.expansion)
         throw std::runtime_error(path + ": the checkpoint was trained with --expansion " + std::to_string(v.toInt()) +
@@ -126,6 +130,7 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
     ar.write("config.expansion", c10::IValue(int64_t(cfg.expansion)));
     if (cfg.arch != RefinerArch::Conv) ar.write("config.arch", c10::IValue(int64_t(cfg.arch)));
     if (cfg.terms) ar.write("config.terms", c10::IValue(int64_t(1)));
+    if (cfg.emitter_cells) ar.write("config.emitter_cells", c10::IValue(int64_t(cfg.emitter_cells)));
     net->save(net_ar);
     ar.write("net", net_ar);
     RefinerNet tmp(cfg);

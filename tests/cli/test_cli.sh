@@ -185,6 +185,16 @@ if [ -d "$shared/models/taesd3" ]; then
     expect_error "--inputs" "$bin" refine "$out/enc_terms" --iterations 4 --expansion 1 -q --resume
     rm "$out/enc_terms/latent_c.exr"
     expect_error "latent_c.exr" "$bin" refine "$out/enc_terms" --iterations 4 --expansion 1 -q --inputs terms
+    # Emitter cells (--emitter-cells): refine traces them from the fit's scene and an identity edit
+    # traces the same grid, so it reproduces the refined latent; resuming without them is refused.
+    cp -r "$out/enc" "$out/enc_cells"
+    "$bin" refine "$out/enc_cells" --iterations 4 --expansion 1 -q --emitter-cells 2
+    check grep -q '"emitter_cells": 2' "$out/enc_cells/metrics.json"
+    "$bin" render "$out/enc_cells" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed_cells"
+    check oiiotool "$out/ed_cells/frame_0000_refined.exr" "$out/enc_cells/latent_refined.exr" --fail 0 --failpercent 0 --diff
+    check sh -c "! cmp -s '$out/ed_cells/frame_0000_refined.exr' '$out/ed/frame_0000_refined.exr'"
+    expect_error "--emitter-cells" "$bin" refine "$out/enc_cells" --iterations 4 --expansion 1 -q --resume
+    expect_error "emitter-cells (fit --refiner-emitter-cells) must be 0 with --augment mirror" "$bin" refine "$out/enc_cells" -q --iterations 2 --emitter-cells 2 --augment mirror
     # Another latent resolution than training: the refiner is fully convolutional.
     "$bin" render "$out/enc" --edit "$out/identity.json" --res 4x3 --spp 2 -q --out "$out/ed_res"
     check test "$(oiiotool --info "$out/ed_res/frame_0000_refined.exr" | grep -c ' 4 x  *3,')" -eq 1

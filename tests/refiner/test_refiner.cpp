@@ -436,7 +436,7 @@ TEST(Refiner, LossDecreasesOnATinyRenderedScene) {
     const std::vector<float> latent = render_toned(fitted, ro, ToneCurve::Clip),
                              target = render_toned(truth, ro, ToneCurve::Clip);
     AovImages aov = render_aovs(scene, SceneSpectra<3>::from_description(scene), res, res, ro.spp, ro.seed);
-    RefinerInput in{res, res, latent, aov.normal, aov.distance, {}};  // no terms
+    RefinerInput in{res, res, latent, aov.normal, aov.distance, {}, {}};  // no terms, no emitter cells
     RefinerConfig cfg = small();
     cfg.distance_scale = 5.f;
     auto r = Refiner::create(cfg, 4);
