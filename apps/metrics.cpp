@@ -140,7 +140,9 @@ private:
 };
 
 Scores score(const std::string& path_a, const std::string& path_b, LpipsOnce& lpips) {
-    Scores s{load(path_a), load(path_b)};
+    Scores s;
+    s.a = load(path_a);
+    s.b = load(path_b);
     const Loaded &a = s.a, &b = s.b;
     if (a.latent != b.latent || a.channels != b.channels)
         throw std::runtime_error("metrics needs the same kind of data in both files: " + path_a + " is " + a.kind +
