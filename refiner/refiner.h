@@ -54,6 +54,9 @@ struct RefinerConfig {
     int emitter_cells = 0;
 };
 
+/// Input channels the emitter cells add: one per sub-cell.
+inline int emitter_cell_channels(const RefinerConfig& c) { return c.emitter_cells * c.emitter_cells; }
+
 /// The stride refine() steps its windows by: window_stride, or half the window when that is 0.
 inline int inference_stride(const RefinerConfig& c) {
     return c.window_stride > 0 ? c.window_stride : std::max(1, c.tile / 2);

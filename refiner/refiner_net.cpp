@@ -113,7 +113,7 @@ int archived_emitter_cells(torch::serialize::InputArchive& ar) {
 
 int64_t refiner_input_channels(const RefinerConfig& config) {
     return int64_t(config.latent_channels) * (config.terms ? 4 : 1) + kRefinerAovChannels +
-           int64_t(config.emitter_cells) * config.emitter_cells;
+           emitter_cell_channels(config);
 }
 
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config) {
@@ -127,7 +127,7 @@ torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& 
                                     std::to_string(h) + " view needs " + std::to_string(3 * c) +
                                     " term channels per pixel (Ĩe, Ĩa, Ĩc), got " + std::to_string(in.terms.size()) +
                                     " values");
-    const int64_t cells = int64_t(config.emitter_cells) * config.emitter_cells;
+    const int64_t cells = emitter_cell_channels(config);
     if (cells && int64_t(in.emitter.size()) != n * cells)
         throw std::invalid_argument("refiner: this refiner reads emitter cells: a " + std::to_string(w) + "x" +
                                     std::to_string(h) + " view needs " + std::to_string(cells) +

@@ -45,7 +45,7 @@ bool archived_terms(torch::serialize::InputArchive& ar);
 int archived_emitter_cells(torch::serialize::InputArchive& ar);
 
 /// The network input [1, refiner_input_channels, h, w] of a view (distance divided by
-/// config.distance_scale; the terms appended when config.terms).
+/// config.distance_scale; the terms appended when config.terms, then the emitter cells).
 /// Throws std::invalid_argument on buffer sizes that do not match width × height.
 torch::Tensor refiner_input_tensor(const RefinerInput& in, const RefinerConfig& config);
 /// [1, C, h, w] → interleaved h × w × C floats.

@@ -49,11 +49,10 @@ float edge_scene_pixel() { return 2.f * std::tan(0.5f * kEdgeFov * kPi / 180.f) 
 /// An emissive rectangle covering world x >= edge (z = 0, facing up) under a camera looking
 /// straight down from height 1 at an 8 × 8 film; nothing else.
 Scene emitter_edge_scene(float edge) {
-    const float fov = kEdgeFov;
     auto s = [](float v) { return std::to_string(v); };
     std::string json = R"({
       "camera": {"fov": )" +
-                       s(fov) +
+                       s(kEdgeFov) +
                        R"(, "width": 8, "height": 8, "filter": {"type": "box"},
                  "to_world": {"lookat": {"origin": [0,0,1], "target": [0,0,0], "up": [0,1,0]}}},
       "materials": {"black": {"type": "diffuse", "reflectance": 0}},

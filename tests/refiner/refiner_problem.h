@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,19 @@ inline RefinerTrainOptions latent_training(int iterations, int crop) {
     o.w_lpips = 0.f;
     o.patience = 0;
     return o;
+}
+
+/// A refiner with `cfg` starts as the identity on `in`, and refuses `lacking` (in without the
+/// extra input `cfg` reads) with an std::invalid_argument naming `named`.
+inline void expect_identity_and_refusal(const RefinerConfig& cfg, const RefinerInput& in, const RefinerInput& lacking,
+                                        const std::string& named) {
+    EXPECT_EQ(Refiner::create(cfg, 2)->refine(in), in.latent);
+    try {
+        Refiner::create(cfg, 2)->refine(lacking);
+        ADD_FAILURE() << "a view lacking " << named << " was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
 }
 
 /// MSE over one latent channel: where a test puts a residual that only one input carries.
