@@ -154,9 +154,13 @@ std::vector<RefinerInput> noise_views(const RefineJob& job, const FitFolder& fit
     report.say("[refine] rendering " + std::to_string(job.noise_views - 1) + " more views of the training view at " +
                std::to_string(spp) + " spp");
     const int w = views[0].width, h = views[0].height;
+    // Emitter cells are the view's geometry, not a sample: every noise view shares the training view's.
+    RefinerConfig without_cells = job.net;
+    without_cells.emitter_cells = 0;
     for (int k = 1; k < job.noise_views; ++k) {
         const uint64_t seed = noise_view_seed(fit_seed(fit), k);
-        views.push_back(fit_refiner_view(fit, job.net, w, h, spp, seed));
+        views.push_back(fit_refiner_view(fit, without_cells, w, h, spp, seed));
+        views.back().emitter = views[0].emitter;
     }
     return views;
 }
