@@ -84,7 +84,8 @@ struct RefineArgs {
 };
 int run_refine(const RefineArgs& args);
 /// "wrote ..." and the rendered / refined / VAE round-trip metrics of a finished stage 2.
-void print_refine_summary(const std::string& fitdir, const pipeline::RefineSummary& summary);
+/// `emitters`: the summary of `refine --emitters`, which wrote the emitter refiner's files.
+void print_refine_summary(const std::string& fitdir, const pipeline::RefineSummary& summary, bool emitters = false);
 
 struct FitArgs {
     pipeline::FitJob job;

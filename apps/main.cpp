@@ -304,8 +304,7 @@ struct Cli {
         fit->add_flag("--resume", f.job.resume,
                       "continue from <out>/checkpoint; one made with other settings is an error");
         fit->add_flag("--restart-if-changed", f.job.restart_if_changed,
-                      "with --resume: a checkpoint made with other settings is removed and the fit starts again "
-                      "(workflows)");
+                      "with --resume: a checkpoint of other settings is removed and the fit starts again (workflows)");
         fit->add_flag("--encode", f.job.encode,
                       "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
         fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")
@@ -356,8 +355,9 @@ struct Cli {
         refine->add_flag("--resume", rf.job.resume,
                          "continue from <fitdir>/refiner_checkpoint.pt; one trained with other settings is an error");
         refine->add_flag("--restart-if-changed", rf.job.restart_if_changed,
-                         "with --resume: a checkpoint trained with other settings is removed and training starts "
-                         "again");
+                         "with --resume: a checkpoint of other settings is removed and training starts again");
+        refine->add_flag("--emitters", rf.job.emitters,
+                         "train refiner_emitters.pt for where edits move emitters (--augment shift; docs/refiner.md)");
         refine->add_flag("-q,--quiet", rf.quiet, "no progress line");
     }
 

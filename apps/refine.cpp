@@ -20,15 +20,19 @@ void show(const nlohmann::json& m, const char* key) {
 
 }  // namespace
 
-void print_refine_summary(const std::string& fitdir, const pipeline::RefineSummary& s) {
-    std::fprintf(stderr, "wrote %s/{refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json%s}\n",
-                 fitdir.c_str(), s.decoded ? ", decoded_refined.png" : "");
+void print_refine_summary(const std::string& fitdir, const pipeline::RefineSummary& s, bool emitters) {
+    if (emitters)
+        std::fprintf(stderr, "wrote %s/{refiner_emitters.pt, refiner_emitters_loss.csv}, added to metrics.json\n",
+                     fitdir.c_str());
+    else
+        std::fprintf(stderr, "wrote %s/{refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json%s}\n",
+                     fitdir.c_str(), s.decoded ? ", decoded_refined.png" : "");
     for (const char* key : {"rendered", "refined", "vae_roundtrip"}) show(s.metrics, key);
 }
 
 int run_refine(const RefineArgs& a) {
     const pipeline::RefineSummary s = pipeline::run_refine(a.job, console_reporter(a.quiet));
-    if (!a.quiet) print_refine_summary(a.job.fitdir, s);
+    if (!a.quiet) print_refine_summary(a.job.fitdir, s, a.job.emitters);
     return 0;
 }
 

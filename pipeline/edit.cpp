@@ -3,6 +3,7 @@
 #include "autodiff/loss.h"
 #include "core/image_io.h"
 #include "pipeline/edit_session.h"
+#include "pipeline/emitter_refiner.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/paths.h"
 #include "pipeline/reference.h"
@@ -155,6 +156,8 @@ std::string frame_key(const EditJob& job) {
         const fs::path p = fs::path(job.fitdir) / file;
         add(fs::exists(p) ? read_file(p.string()) : std::string("absent"));
     }
+    const fs::path emitters = fs::path(job.fitdir) / kEmitterRefinerFile;
+    if (fs::exists(emitters)) add(read_file(emitters.string()));  // only then: other folders keep their keys
     add(read_file(job.edits));
     for (const auto& [key, value] : job.defines) add(key + "=" + value);
     if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before

@@ -1,4 +1,5 @@
 #include "pipeline/edit_session.h"
+#include "pipeline/emitter_refiner.h"
 #include "pipeline/refiner_io.h"
 #include <filesystem>
 #include <stdexcept>
@@ -9,8 +10,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The already edited scene of `fit` at spp with seed, refined when `refiner` is given.
-FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int width, int height, int spp, uint64_t seed) {
+/// The already edited scene of `fit` at spp with seed, refined when `refiner` is given, and by
+/// `emitters` (when given) where emitters are seen otherwise than `training_coverage` says.
+FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, const Refiner* emitters,
+                          const std::vector<float>& training_coverage, int width, int height, int spp, uint64_t seed) {
     FrameLatents f;
     f.width = width;
     f.height = height;
@@ -21,7 +24,7 @@ FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, int widt
     // Same spp and seed as the fit's latent: an identity edit reproduces its refined latent.
     f.view = fit_refiner_view(fit, refiner->config(), width, height, spp, seed);
     f.latent = f.view.latent;
-    f.refined = refiner->refine(f.view);
+    f.refined = refine_with_emitters(*refiner, emitters, *fit.scene, f.view, training_coverage);
     return f;
 }
 
@@ -34,6 +37,16 @@ EditSession::EditSession(const std::string& fitdir, const std::string& edits,
       m_camera(m_fit.scene->camera) {
     const fs::path pt = fs::path(fitdir) / "refiner.pt";
     if (fs::exists(pt)) m_refiner = Refiner::load(pt.string());
+    const fs::path emitters = fs::path(fitdir) / kEmitterRefinerFile;
+    if (fs::exists(emitters)) {
+        if (!m_refiner)
+            throw std::runtime_error(emitters.string() +
+                                     ": an emitter refiner without refiner.pt beside it; train the "
+                                     "main refiner (latentpt refine) or remove the file");
+        m_emitter_refiner = Refiner::load(emitters.string());
+        check_emitter_refiner_inputs(m_refiner->config(), m_emitter_refiner->config(), emitters.string());
+        m_training_coverage = emitter_coverage(*m_fit.scene, m_fit.latent_width, m_fit.latent_height);
+    }
     for (const Shape& s : m_fit.scene->shapes) m_original.push_back(s.mesh);
 }
 
@@ -42,8 +55,9 @@ FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int he
         throw std::invalid_argument("frame " + std::to_string(i) +
                                     " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
     apply_edits(m_edits, time(i), m_original, m_camera, *m_fit.scene);
-    return edited_frame(m_fit, m_refiner.get(), width > 0 ? width : m_fit.latent_width,
-                        height > 0 ? height : m_fit.latent_height, spp, seed + uint64_t(i));
+    return edited_frame(m_fit, m_refiner.get(), m_emitter_refiner.get(), m_training_coverage,
+                        width > 0 ? width : m_fit.latent_width, height > 0 ? height : m_fit.latent_height, spp,
+                        seed + uint64_t(i));
 }
 
 }  // namespace lpt::pipeline

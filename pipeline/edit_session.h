@@ -23,8 +23,9 @@ struct FrameLatents {
 
 class EditSession {
 public:
-    /// Loads the fit folder (defines override its -D values, sampler its sampler), its refiner when it has one, and
-    /// the edit sequence; throws naming the file on bad input.
+    /// Loads the fit folder (defines override its -D values, sampler its sampler), its refiner and
+    /// emitter refiner when it has them (pipeline/emitter_refiner.h), and the edit sequence;
+    /// throws naming the file on bad input.
     EditSession(const std::string& fitdir, const std::string& edits,
                 const std::map<std::string, std::string>& defines = {},
                 std::optional<SamplerKind> sampler = std::nullopt);
@@ -46,6 +47,8 @@ private:
     FitFolder m_fit;
     EditSequence m_edits;
     std::unique_ptr<Refiner> m_refiner;
+    std::unique_ptr<Refiner> m_emitter_refiner;  ///< refiner_emitters.pt, when the fit folder has one
+    std::vector<float> m_training_coverage;      ///< with it: emitter_coverage of the unedited view
     std::vector<TriangleMesh> m_original;
     Camera m_camera;
 };

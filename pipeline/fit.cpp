@@ -3,6 +3,7 @@
 #include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
+#include "pipeline/emitter_refiner.h"
 #include "pipeline/fit_checkpoint.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/output_lock.h"
@@ -195,6 +196,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
 
     const OutputLock lock(job.out);  // before anything is written there
     const bool resume = prepare_checkpoint(o.checkpoint_dir, stage1_settings(job), job.resume, job.restart_if_changed);
+    if (!resume) remove_emitter_refiner(job.out);  // it was trained on another stage 1's renders
     std::unique_ptr<Vae> vae;
     if (job.encode) vae = open_vae(job.vae);
     const Target target = !job.target.empty() ? load_target_exr(job.target)

@@ -4,6 +4,7 @@
 #include "core/sampler.h"
 #include "integrators/aov.h"
 #include "latent/latent.h"
+#include "pipeline/emitter_refiner.h"
 #include "pipeline/fit_checkpoint.h"
 #include "pipeline/fit_folder.h"
 #include "pipeline/output_lock.h"
@@ -262,6 +263,36 @@ std::string refine_status(const RefinerRecord& r) {
     return buf;
 }
 
+/// The files a refine job trains: the main refiner's, or (job.emitters) the emitter refiner's.
+struct RefinerFiles {
+    fs::path weights, checkpoint, loss;
+};
+
+RefinerFiles refiner_files(const RefineJob& job) {
+    const fs::path dir(job.fitdir);
+    if (!job.emitters) return {dir / "refiner.pt", dir / "refiner_checkpoint.pt", dir / "refiner_loss.csv"};
+    return {dir / kEmitterRefinerFile, dir / kEmitterRefinerCheckpoint, dir / kEmitterRefinerLoss};
+}
+
+/// An emitter refiner is trained beside refiner.pt, which must be there and read what it reads.
+void require_main_refiner(const RefineJob& job) {
+    const fs::path pt = fs::path(job.fitdir) / "refiner.pt";
+    if (!fs::exists(pt))
+        throw std::runtime_error(pt.string() +
+                                 ": not found; refine --emitters trains a second refiner beside the "
+                                 "main one: train that first (latentpt refine, or fit)");
+    check_emitter_refiner_inputs(Refiner::load(pt.string())->config(), job.net,
+                                 (fs::path(job.fitdir) / kEmitterRefinerFile).string());
+}
+
+/// metrics.json as it is, or an empty object when there is none (or it is not JSON).
+nlohmann::json existing_metrics(const fs::path& dir) {
+    const fs::path path = dir / "metrics.json";
+    if (!fs::exists(path)) return nlohmann::json::object();
+    nlohmann::json m = nlohmann::json::parse(read_file(path.string()), nullptr, false);
+    return m.is_object() ? m : nlohmann::json::object();
+}
+
 /// The refiner's inference window: its training crop, when InstanceNorm makes the output depend
 /// on the statistics of what the network sees and the crop is smaller than the view; else 0
 /// (the whole view, which is then also what training saw).
@@ -269,6 +300,32 @@ int inference_window(const RefineJob& job, const RefinerInput& in) {
     const int crop = job.train.crop;
     if (!job.windowed_inference || !job.net.instance_norm || crop <= 0) return 0;
     return crop < in.width || crop < in.height ? crop : 0;
+}
+
+/// What a trained refiner leaves in the fit folder: its weights and loss history, and for the
+/// main refiner the refined training view and metrics.json (in s.metrics); an emitter refiner's
+/// record is added to metrics.json, whose other records stay.
+void write_results(const RefineJob& job, const RefinerFiles& files, const Refiner& refiner, const RefinerInput& in,
+                   const Image& target, const Judges& judges, RefineSummary& s) {
+    const fs::path dir(job.fitdir);
+    refiner.save(files.weights.string());
+    write_text_atomic(files.loss.string(), refiner_csv(s.result));
+    const nlohmann::json before = existing_metrics(dir);
+    if (job.emitters) {
+        // The training view sees every emitter as in training, where the main refiner's output
+        // stands: its refined latent and metrics are unchanged.
+        s.metrics = before;
+        s.metrics["emitter_refiner"] = training_record(job, refiner, s.result);
+    } else {
+        const std::vector<float> refined = refiner.refine(in);
+        write_latent((dir / "latent_refined.exr").string(), in.width, in.height, refined);
+        s.metrics = judge(dir, in, refined, target, judges);
+        s.metrics["refiner"] = training_record(job, refiner, s.result);
+        if (before.contains("emitter_refiner") && fs::exists(dir / kEmitterRefinerFile))
+            s.metrics["emitter_refiner"] = before["emitter_refiner"];
+        s.decoded = judges.vae != nullptr && !judges.ref_rgb.empty();
+    }
+    write_text_atomic((dir / "metrics.json").string(), s.metrics.dump(2));
 }
 
 }  // namespace
@@ -319,6 +376,8 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     if (job.net.terms) in.terms = load_refiner_terms(job.fitdir, in.width, in.height);
     const Image target = read_fit_image((dir / "target.exr").string(), kLatentChannels, in.width, in.height);
     const Judges judges = open_judges(job, target, report);
+    const RefinerFiles files = refiner_files(job);
+    if (job.emitters) require_main_refiner(job);
 
     RefinerConfig cfg = job.net;
     cfg.latent_channels = kLatentChannels;
@@ -327,7 +386,7 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     cfg.window_stride = cfg.tile > 0 ? job.window_stride : 0;
     auto refiner = Refiner::create(cfg, job.train.seed);
     RefinerTrainOptions o = job.train;
-    o.checkpoint_path = (dir / "refiner_checkpoint.pt").string();
+    o.checkpoint_path = files.checkpoint.string();
     o.resume = prepare_refiner_checkpoint(o.checkpoint_path, stage2_settings(job),
                                           job.resume && fs::exists(o.checkpoint_path), job.restart_if_changed);
     bool cancelled = false;
@@ -368,15 +427,7 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
     std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,
                   s.result.best_iteration);
     report.say(best);
-    refiner->save((dir / "refiner.pt").string());
-
-    const std::vector<float> refined = refiner->refine(in);
-    write_latent((dir / "latent_refined.exr").string(), in.width, in.height, refined);
-    write_text_atomic((dir / "refiner_loss.csv").string(), refiner_csv(s.result));
-    s.metrics = judge(dir, in, refined, target, judges);
-    s.metrics["refiner"] = training_record(job, *refiner, s.result);
-    s.decoded = judges.vae != nullptr && !judges.ref_rgb.empty();
-    write_text_atomic((dir / "metrics.json").string(), s.metrics.dump(2));
+    write_results(job, files, *refiner, in, target, judges, s);
     return s;
 }
 

@@ -1,6 +1,7 @@
 // Stage 2 as a library call: trains the per-scene refiner on a fit folder's final render
 // (latent.exr, aov.exr) against target.exr (and reference_rgb.exr for LPIPS when present) and
-// writes refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json and decoded_refined.png.
+// writes refiner.pt, latent_refined.exr, refiner_loss.csv, metrics.json and decoded_refined.png;
+// with RefineJob::emitters the emitter refiner instead (pipeline/emitter_refiner.h).
 #pragma once
 #include "core/sampler.h"
 #include "pipeline/progress.h"
@@ -44,6 +45,12 @@ struct RefineJob {
     /// and training starts again, instead of an error (pipeline/fit_checkpoint.h).
     bool restart_if_changed = false;
     std::string lpips_dir;  ///< empty = ../shared/models/lpips
+    /// Train the emitter refiner (pipeline/emitter_refiner.h) instead of the main one: its files
+    /// are refiner_emitters.pt, refiner_emitters_checkpoint.pt (.json) and
+    /// refiner_emitters_loss.csv, and its record is added to metrics.json. It needs refiner.pt
+    /// beside it; the training view's refined latent is the main refiner's alone (the emitters
+    /// are where training saw them).
+    bool emitters = false;
 };
 
 struct RefineSummary {

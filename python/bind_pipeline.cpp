@@ -91,6 +91,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "sampler" && prefix.empty()) job.sampler = sampler_choice(value.cast<std::string>(), shown);
     else if (k == "seed") t.seed = value.cast<uint64_t>();
     else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
+    else if (k == "emitters" && prefix.empty()) job.emitters = value.cast<bool>();
     else return false;
     return true;
 }
@@ -235,7 +236,7 @@ void bind_pipeline(py::module_& m) {
           py::arg("note") = py::none(),
           "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
           "(iterations, lr, lr_decay, crop, patience, augment, noise_views, latent_target, norm, arch, inputs, "
-          "inference, dropout, seed, ...).");
+          "inference, dropout, seed, emitters, ...).");
     m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("sampler") = "", py::arg("progress") = py::none(),
           py::arg("note") = py::none(),

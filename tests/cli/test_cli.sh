@@ -195,6 +195,24 @@ if [ -d "$shared/models/taesd3" ]; then
     check sh -c "! cmp -s '$out/ed_cells/frame_0000_refined.exr' '$out/ed/frame_0000_refined.exr'"
     expect_error "--emitter-cells" "$bin" refine "$out/enc_cells" --iterations 4 --expansion 1 -q --resume
     expect_error "emitter-cells (fit --refiner-emitter-cells) must be 0 with --augment mirror" "$bin" refine "$out/enc_cells" -q --iterations 2 --emitter-cells 2 --augment mirror
+    # The emitter refiner (--emitters): trained beside refiner.pt, the training view's refined
+    # latent unchanged; an identity edit is the main refiner's alone, a frame whose light moved
+    # takes its output there; refused without refiner.pt.
+    cp -r "$out/enc" "$out/enc_emit"
+    "$bin" refine "$out/enc_emit" --emitters --iterations 4 --expansion 1 -q --augment shift
+    check test -s "$out/enc_emit/refiner_emitters.pt"
+    check grep -q '"emitter_refiner"' "$out/enc_emit/metrics.json"
+    check cmp "$out/enc_emit/latent_refined.exr" "$out/enc/latent_refined.exr"
+    "$bin" render "$out/enc_emit" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed_emit"
+    check oiiotool "$out/ed_emit/frame_0000_refined.exr" "$out/ed/frame_0000_refined.exr" --fail 0 --failpercent 0 --diff
+    for d in enc enc_emit; do
+        "$bin" render "$out/$d" --edit "$out/move0.json" --frames 1:1 --spp 2 -q --out "$out/mv_$d"
+    done
+    check oiiotool "$out/mv_enc/frame_0001_latent.exr" "$out/mv_enc_emit/frame_0001_latent.exr" --fail 0 --failpercent 0 --diff
+    check sh -c "! cmp -s '$out/mv_enc/frame_0001_refined.exr' '$out/mv_enc_emit/frame_0001_refined.exr'"
+    rm "$out/enc_emit/refiner.pt"
+    expect_error "refiner.pt: not found" "$bin" refine "$out/enc_emit" --emitters --iterations 2 -q
+    expect_error "without refiner.pt" "$bin" render "$out/enc_emit" --edit "$out/identity.json" -q --out "$out/ed_emit2"
     # Another latent resolution than training: the refiner is fully convolutional.
     "$bin" render "$out/enc" --edit "$out/identity.json" --res 4x3 --spp 2 -q --out "$out/ed_res"
     check test "$(oiiotool --info "$out/ed_res/frame_0000_refined.exr" | grep -c ' 4 x  *3,')" -eq 1

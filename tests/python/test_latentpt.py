@@ -308,6 +308,11 @@ class OneProcessTest(unittest.TestCase):
                                check=True, stdout=subprocess.DEVNULL)
                 with open(os.path.join(fit, "refiner.pt"), "rb") as a, open(os.path.join(cli, "refiner.pt"), "rb") as b:
                     self.assertEqual(a.read(), b.read())
+            # emitters=True: the emitter refiner beside it (reading what it reads), the record added
+            latentpt.refine(fit, note=lambda t: None, iterations=2, expansion=1, inputs="terms", emitters=True)
+            self.assertTrue(os.path.exists(os.path.join(fit, "refiner_emitters.pt")))
+            with open(os.path.join(fit, "metrics.json")) as f:
+                self.assertEqual(json.load(f)["emitter_refiner"]["iterations"], 2)
             with self.assertRaises(TypeError):
                 latentpt.refine(fit, crops=4)
             for bad, name in (({"dropout": 1.5}, "dropout"), ({"lr_decay": "linear"}, "lr_decay"),
