@@ -141,6 +141,9 @@ def main():
     ap.add_argument("--refiner-dropout", type=float, default=None,
                     help="the refiner dropout of the fits that refine (default: the preset's, 0, else the fit's own, "
                          "0.1; docs/results.md \"No dropout, one view\")")
+    ap.add_argument("--refiner-emitters", choices=["on", "off"], default=None,
+                    help="train an emitter refiner beside each fit's refiner (default: the preset's, on, else off; "
+                         "docs/refiner.md \"Emitter refiner\")")
     ap.add_argument("--second-references", action="store_true",
                     help="also trace every scored frame's reference again with another seed and add Table 1 against "
                          "these independent references (MSE less their noise) to the summary; costs about the edit "
@@ -158,7 +161,8 @@ def main():
                    fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk,
                    paper=a.paper, frame_step=a.frame_step, emission_decay=a.emission_decay, param=a.param,
                    emitter_response_decay=a.emitter_response_decay, second_references=a.second_references,
-                   refiner_latent_target=a.refiner_latent_target, refiner_dropout=a.refiner_dropout)
+                   refiner_latent_target=a.refiner_latent_target, refiner_dropout=a.refiner_dropout,
+                   refiner_emitters=None if a.refiner_emitters is None else a.refiner_emitters == "on")
     for s in c["scenes"]:
         if s not in X.SCENES:
             sys.exit(f"experiment: unknown scene '{s}' (have {', '.join(X.SCENES)})")

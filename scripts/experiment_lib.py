@@ -126,6 +126,7 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
                "baseline+refiner": "#e377c2"}
     configs, step = configs_of(c), c.get("frame_step", 1)
     dropout = f", dropout {c['refiner_dropout']:g}" if c.get("refiner_dropout") is not None else ""
+    dropout += ", emitter refiner" if c.get("refiner_emitters") else ""
     md = ["# latentpt experiment summary", "",
           f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
           "reference spp per scene below, "
@@ -276,13 +277,13 @@ PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
          "refiner_iterations": 6000, "refiner_lr_decay": "cosine", "fits": ["e", "ea", "eac"],
          "spp_list": [1, 4, 16, 64, 256], "conv_views": ["training"], "equal_error_max_spp": 64,
          "emitter_response_decay": 1e-4, "refiner_latent_target": "compensated",
-         "refiner_dropout": 0.0}
+         "refiner_dropout": 0.0, "refiner_emitters": True}
 
 
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
              fit_iterations=None, refiner_iterations=None, spp=64, chunk=8, paper=False, frame_step=None,
              emission_decay=None, emitter_response_decay=None, param=None, second_references=False,
-             refiner_latent_target=None, refiner_dropout=None):
+             refiner_latent_target=None, refiner_dropout=None, refiner_emitters=None):
     """The workflow's config (JSON-able): --quick's small sizes, --paper's preset or the full run's;
     flags given explicitly win over the preset's values."""
     p = PAPER if paper else {}
@@ -298,6 +299,7 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "refiner_latent_target": refiner_latent_target or p.get("refiner_latent_target", "encoded"),
             # None: the fit's own default (not named, so the commands of earlier runs stay as they were)
             "refiner_dropout": p.get("refiner_dropout") if refiner_dropout is None else refiner_dropout,
+            "refiner_emitters": p.get("refiner_emitters", False) if refiner_emitters is None else refiner_emitters,
             "emission_decay": p.get("emission_decay", 0) if emission_decay is None else emission_decay,
             "emitter_response_decay": p.get("emitter_response_decay", 0) if emitter_response_decay is None else emitter_response_decay,
             "param": p.get("param", "code") if param is None else param,
@@ -409,13 +411,37 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
     return cmd
 
 
+# The emitter refiner (docs/refiner.md "Emitter refiner"): film shifts, a quarter of the width,
+# 3000 steps; on the Cornell box as good as a full-width 6000-step one (docs/results.md).
+EMITTER_REFINER_ARGS = ["--emitters", "--augment", "shift", "--expansion", "4", "--iterations", "3000",
+                        "--patience", "0"]
+
+
+def emitter_refiner_argv(c, fitdir, threads):
+    """`latentpt refine --emitters` beside a fit's refiner, with the config's other refiner settings."""
+    cmd = [c["bin"], "--threads", str(threads), "refine", fitdir, "-q"] + EMITTER_REFINER_ARGS
+    if c.get("refiner_lr_decay", "none") != "none":
+        cmd += ["--lr-decay", c["refiner_lr_decay"]]
+    if c.get("refiner_latent_target", "encoded") != "encoded":
+        cmd += ["--latent-target", c["refiner_latent_target"]]
+    if c.get("refiner_dropout") is not None:
+        cmd += ["--dropout", repr(float(c["refiner_dropout"]))]
+    return cmd
+
+
 def fit_command(c, scene, name, threads):
-    """`latentpt fit` of one ablation fit; --resume continues a killed one from its checkpoint."""
+    """`latentpt fit` of one ablation fit (and with refiner_emitters its emitter refiner); --resume
+    continues a killed one from its checkpoint."""
     d = os.path.join(scene, "fit_" + name)
     # --restart-if-changed: a rerun with changed parameters (Snakemake reruns the job) must not
     # continue the old fit's checkpoint; a killed run of the same command continues it.
-    return shlex.join(fit_argv(c, scene, name, threads, d)) + \
+    cmd = shlex.join(fit_argv(c, scene, name, threads, d)) + \
         f" $([ -f {shlex.quote(d)}/checkpoint/state.json ] && echo --resume --restart-if-changed)"
+    if not (FITS[name][2] and c.get("refiner_emitters")):
+        return cmd
+    # in a subshell, so that the job's "> log 2>&1" takes both commands' output
+    return "( " + cmd + " && " + shlex.join(emitter_refiner_argv(c, d, threads)) + \
+        f" $([ -f {shlex.quote(d)}/refiner_emitters_checkpoint.pt ] && echo --resume --restart-if-changed) )"
 
 
 def training_reference_command(c, scene, threads):

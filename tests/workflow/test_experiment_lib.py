@@ -82,6 +82,23 @@ class Preset(unittest.TestCase):
         c = X.settings(paper=True, refiner_dropout=0.1)  # an explicit value wins over the preset's
         self.assertIn("--refiner-dropout 0.1", X.fit_command(c, "cbox-specular", "eac", 2))
 
+    def test_emitter_refiner_only_beside_a_refiner_and_only_when_on(self):
+        paper = X.settings(paper=True)
+        cmd = X.fit_command(paper, "cbox-specular", "eac", 2)  # the preset's
+        at = cmd.index(" && " + paper["bin"])  # after the fit's own "$([ -f ... ] && echo ...)"
+        fit, emitters = cmd[:at], cmd[at:]
+        self.assertTrue(cmd.startswith("( ") and cmd.endswith(" )"))  # the job's log takes both
+        self.assertNotIn("--emitters", fit)
+        for part in ("refine cbox-specular/fit_eac", "--emitters", "--augment shift", "--expansion 4",
+                     "--lr-decay cosine", "--latent-target compensated", "--dropout 0.0",
+                     "cbox-specular/fit_eac/refiner_emitters_checkpoint.pt ] && echo --resume --restart-if-changed"):
+            self.assertIn(part, emitters)
+        self.assertNotIn("--emitters", X.fit_command(paper, "cbox-specular", "ea", 2))  # no refiner
+        self.assertNotIn("--emitters", X.training_reference_command(paper, "cbox-specular", 2))
+        # off by default and when asked: the fit's command alone, as before the option
+        for c in (X.settings(), X.settings(paper=True, refiner_emitters=False)):
+            self.assertNotIn(" refine ", X.fit_command(c, "cbox-specular", "eac", 2))
+
     def test_training_reference_is_a_one_iteration_fit_into_refs(self):
         cmd = X.training_reference_command(X.settings(paper=True), "cbox-specular", 2)
         for part in ("--iterations 1 ", "--reference-cache cbox-specular/refs", "--no-refiner", "--encode-res 1024x1024"):
@@ -116,6 +133,10 @@ class Table1(unittest.TestCase):
         _, misses = X.table1(c, self.summary(good[:3] + [(0.07, 0.02)], (0.04, 0.01)))
         self.assertEqual(sorted(m.split(" ")[0] for m in misses if "1.5× the round trip" in m),
                          ["cbox-specular/light", "cbox-specular/object"])
+        # a miss that three digits would print as equal to its bound shows a fourth
+        _, misses = X.table1(c, self.summary(good[:3] + [(0.0754, 0.02)], (0.005, 0.01)))
+        self.assertIn("cbox-specular/camera LPIPS: refined 0.0754 above the paper 0.0750", misses)
+        self.assertIn("cbox-specular/object LPIPS: refined 0.075 above the paper 0.032", misses)
 
     def test_html_marks_the_missed_values(self):
         c = X.settings(paper=True, scenes=["cbox-specular"])
