@@ -19,7 +19,8 @@ std::vector<float> dilate_mask(const std::vector<float>& mask, int w, int h, int
         for (int x = 0; x < w; ++x) {
             if (mask[size_t(y) * w + x] == 0.f) continue;
             for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v)
-                for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u) out[size_t(v) * w + u] = 1.f;
+                for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
+                    out[size_t(v) * w + u] = 1.f;
         }
     return out;
 }

@@ -22,8 +22,8 @@ namespace {
 
 const std::string kBox = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json";
 
-/// A small fit of the bundled box with a main refiner of two steps, in <dir>/fit.
-std::string small_fit_with_refiner(const std::string& dir) {
+/// A small fit of the bundled box in <dir>/fit, with a main refiner of two steps when `refiner`.
+std::string small_fit(const std::string& dir, bool refiner = true) {
     pipeline::FitJob job;
     job.scene = kBox;
     job.defines = {{"integrator.max_depth", "3"}};
@@ -32,7 +32,7 @@ std::string small_fit_with_refiner(const std::string& dir) {
     job.options.iterations = 10;
     job.options.spp = 2;
     job.final_spp = 4;
-    job.refiner = true;
+    job.refiner = refiner;
     job.refine.net.expansion = 1;
     job.refine.train.iterations = 2;
     pipeline::run_fit(job);
@@ -146,19 +146,10 @@ TEST(EmitterRefiner, TakesTheEmitterRefinersValuesExactlyWhereTheMaskIsSet) {
 // Without refiner.pt there is nothing to blend into: an error naming it, before any training.
 // Refiners that read different inputs cannot share a view: an error naming the emitter refiner.
 TEST(EmitterRefiner, NeedsTheMainRefinerAndItsInputs) {
-    const std::string dir = test::temp_dir("emitter-refiner-errors");
-    pipeline::FitJob job;
-    job.scene = kBox;
-    job.out = dir + "/fit";
-    job.synthetic_res = "8x8";
-    job.options.iterations = 2;
-    job.options.spp = 1;
-    job.final_spp = 1;
-    job.refiner = false;
-    pipeline::run_fit(job);
-    test::expect_error_naming([&] { pipeline::run_refine(emitter_job(job.out)); }, {"refiner.pt", "not found"},
+    const std::string fitdir = small_fit(test::temp_dir("emitter-refiner-errors"), false);
+    test::expect_error_naming([&] { pipeline::run_refine(emitter_job(fitdir)); }, {"refiner.pt", "not found"},
                               "an emitter refiner was trained without a main refiner");
-    EXPECT_FALSE(fs::exists(fs::path(job.out) / pipeline::kEmitterRefinerFile));
+    EXPECT_FALSE(fs::exists(fs::path(fitdir) / pipeline::kEmitterRefinerFile));
     RefinerConfig main, emitters;
     main.terms = true;
     test::expect_error_naming([&] { pipeline::check_emitter_refiner_inputs(main, emitters, "x/refiner_emitters.pt"); },
@@ -169,7 +160,7 @@ TEST(EmitterRefiner, NeedsTheMainRefinerAndItsInputs) {
 // cells unchanged, the record added); an edited frame that moves the light is the main
 // refiner's output with the emitter refiner's on the mask, computed here from the two files.
 TEST(EmitterRefiner, EditedFramesTakeItsOutputWhereTheLightMoved) {
-    const std::string fitdir = small_fit_with_refiner(test::temp_dir("emitter-refiner-blend"));
+    const std::string fitdir = small_fit(test::temp_dir("emitter-refiner-blend"));
     const std::string refined_before = read_file(fitdir + "/latent_refined.exr");
     const nlohmann::json metrics_before = nlohmann::json::parse(read_file(fitdir + "/metrics.json"));
     const pipeline::RefineSummary s = pipeline::run_refine(emitter_job(fitdir));
@@ -187,9 +178,8 @@ TEST(EmitterRefiner, EditedFramesTakeItsOutputWhereTheLightMoved) {
     EXPECT_EQ(f0.refined, main->refine(f0.view)) << "the unedited view is not the main refiner's";
     const std::vector<float> training = pipeline::emitter_coverage(*session.fit().scene, f0.width, f0.height);
     const pipeline::FrameLatents f = session.frame(3, 2, 5);  // the light and the camera moved
-    const std::vector<float> mask =
-        pipeline::emitter_mask(pipeline::emitter_coverage(*session.fit().scene, f.width, f.height), training, f.width,
-                               f.height);
+    const std::vector<float> mask = pipeline::emitter_mask(
+        pipeline::emitter_coverage(*session.fit().scene, f.width, f.height), training, f.width, f.height);
     const std::vector<float> a = main->refine(f.view), b = emitters->refine(f.view);
     ASSERT_EQ(f.refined.size(), a.size());
     int inside = 0, outside = 0, differ = 0;
@@ -205,7 +195,7 @@ TEST(EmitterRefiner, EditedFramesTakeItsOutputWhereTheLightMoved) {
 
     // A new stage 1 in the folder makes the emitter refiner stale: its files go, and so does its
     // record when the main refiner writes metrics.json again.
-    small_fit_with_refiner(fs::path(fitdir).parent_path().string());
+    small_fit(fs::path(fitdir).parent_path().string());
     for (const char* name : {pipeline::kEmitterRefinerFile, pipeline::kEmitterRefinerCheckpoint,
                              pipeline::kEmitterRefinerLoss, "refiner_emitters_checkpoint.json"})
         EXPECT_FALSE(fs::exists(fs::path(fitdir) / name)) << name;
