@@ -373,6 +373,20 @@ def chunks(c, scene, kind):
     return [(f[i], f[min(i + k, len(f)) - 1]) for i in range(0, len(f), k)]
 
 
+def refiner_setting_args(c, prefix):
+    """The config's refiner settings as options of `latentpt fit` (prefix "--refiner-") or `refine`
+    ("--"). Each is named only when on, so the commands of constant-rate configs (and configs
+    written before the option, which have no key) stay as they were."""
+    args = []
+    if c.get("refiner_lr_decay", "none") != "none":
+        args += [prefix + "lr-decay", c["refiner_lr_decay"]]
+    if c.get("refiner_latent_target", "encoded") != "encoded":
+        args += [prefix + "latent-target", c["refiner_latent_target"]]
+    if c.get("refiner_dropout") is not None:
+        args += [prefix + "dropout", repr(float(c["refiner_dropout"]))]
+    return args
+
+
 def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refiner=None, decay=True):
     """`latentpt fit` arguments of one ablation fit into `out` (iterations: the config's;
     refiner: None = as the fit's FITS entry says, False = stage 1 only; decay: pass the config's
@@ -390,14 +404,8 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
     # 937 of 3000, loss 0.0277 against ea's 0.0209), so the ablation compared unequal fits.
     cmd += ["--patience", "0"]
     cmd += ["--refiner-iterations", str(c["refiner_iterations"])] if refine else ["--no-refiner"]
-    # named only when on, so the commands of constant-rate configs (and configs written before the
-    # option, which have no key) stay as they were
-    if refine and c.get("refiner_lr_decay", "none") != "none":
-        cmd += ["--refiner-lr-decay", c["refiner_lr_decay"]]
-    if refine and c.get("refiner_latent_target", "encoded") != "encoded":
-        cmd += ["--refiner-latent-target", c["refiner_latent_target"]]
-    if refine and c.get("refiner_dropout") is not None:
-        cmd += ["--refiner-dropout", repr(float(c["refiner_dropout"]))]
+    if refine:
+        cmd += refiner_setting_args(c, "--refiner-")
     if decay and c.get("emission_decay", 0):
         cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     if decay and c.get("emitter_response_decay", 0):
@@ -419,14 +427,8 @@ EMITTER_REFINER_ARGS = ["--emitters", "--augment", "shift", "--expansion", "4", 
 
 def emitter_refiner_argv(c, fitdir, threads):
     """`latentpt refine --emitters` beside a fit's refiner, with the config's other refiner settings."""
-    cmd = [c["bin"], "--threads", str(threads), "refine", fitdir, "-q"] + EMITTER_REFINER_ARGS
-    if c.get("refiner_lr_decay", "none") != "none":
-        cmd += ["--lr-decay", c["refiner_lr_decay"]]
-    if c.get("refiner_latent_target", "encoded") != "encoded":
-        cmd += ["--latent-target", c["refiner_latent_target"]]
-    if c.get("refiner_dropout") is not None:
-        cmd += ["--dropout", repr(float(c["refiner_dropout"]))]
-    return cmd
+    return [c["bin"], "--threads", str(threads), "refine", fitdir, "-q"] + EMITTER_REFINER_ARGS + \
+        refiner_setting_args(c, "--")
 
 
 def fit_command(c, scene, name, threads):
