@@ -274,6 +274,21 @@ RefinerFiles refiner_files(const RefineJob& job) {
     return {dir / kEmitterRefinerFile, dir / kEmitterRefinerCheckpoint, dir / kEmitterRefinerLoss};
 }
 
+/// metrics.json as it is, or an empty object when there is none. One that is not a JSON object
+/// is an error when `strict` (an emitter refiner adds its record to the main refiner's cells,
+/// which would be lost); the main refiner writes the file anew and reads it as empty.
+nlohmann::json existing_metrics(const fs::path& dir, bool strict) {
+    const fs::path path = dir / "metrics.json";
+    if (!fs::exists(path)) return nlohmann::json::object();
+    nlohmann::json m = nlohmann::json::parse(read_file(path.string()), nullptr, false);
+    if (m.is_object()) return m;
+    if (strict)
+        throw std::runtime_error(path.string() +
+                                 ": not a JSON object; refine --emitters adds its record to the main "
+                                 "refiner's metrics: train that again (latentpt refine)");
+    return nlohmann::json::object();
+}
+
 /// An emitter refiner is trained beside refiner.pt, which must be there and read what it reads.
 void require_main_refiner(const RefineJob& job) {
     const fs::path pt = fs::path(job.fitdir) / "refiner.pt";
@@ -283,14 +298,7 @@ void require_main_refiner(const RefineJob& job) {
                                  "main one: train that first (latentpt refine, or fit)");
     check_emitter_refiner_inputs(Refiner::load(pt.string())->config(), job.net,
                                  (fs::path(job.fitdir) / kEmitterRefinerFile).string());
-}
-
-/// metrics.json as it is, or an empty object when there is none (or it is not JSON).
-nlohmann::json existing_metrics(const fs::path& dir) {
-    const fs::path path = dir / "metrics.json";
-    if (!fs::exists(path)) return nlohmann::json::object();
-    nlohmann::json m = nlohmann::json::parse(read_file(path.string()), nullptr, false);
-    return m.is_object() ? m : nlohmann::json::object();
+    existing_metrics(job.fitdir, true);  // before training: its record goes there
 }
 
 /// The refiner's inference window: its training crop, when InstanceNorm makes the output depend
@@ -310,7 +318,7 @@ void write_results(const RefineJob& job, const RefinerFiles& files, const Refine
     const fs::path dir(job.fitdir);
     refiner.save(files.weights.string());
     write_text_atomic(files.loss.string(), refiner_csv(s.result));
-    const nlohmann::json before = existing_metrics(dir);
+    const nlohmann::json before = existing_metrics(dir, job.emitters);
     if (job.emitters) {
         // The training view sees every emitter as in training, where the main refiner's output
         // stands: its refined latent and metrics are unchanged.

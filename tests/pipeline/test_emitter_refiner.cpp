@@ -156,6 +156,17 @@ TEST(EmitterRefiner, NeedsTheMainRefinerAndItsInputs) {
                               {"x/refiner_emitters.pt", "--inputs"}, "refiners with other inputs were paired");
 }
 
+// Its record joins the main refiner's cells in metrics.json: one that is not JSON would lose
+// them, so it is an error naming the file, before any training.
+TEST(EmitterRefiner, RefusesAMalformedMetricsFile) {
+    const std::string fitdir = small_fit(test::temp_dir("emitter-refiner-metrics"));
+    write_text_atomic(fitdir + "/metrics.json", "{\"refined\": ");
+    test::expect_error_naming([&] { pipeline::run_refine(emitter_job(fitdir)); }, {"metrics.json", "JSON object"},
+                              "an emitter refiner overwrote a malformed metrics.json");
+    EXPECT_FALSE(fs::exists(fs::path(fitdir) / pipeline::kEmitterRefinerFile));
+    EXPECT_EQ(read_file(fitdir + "/metrics.json"), "{\"refined\": ");
+}
+
 // The training view keeps the main refiner's output (latent_refined.exr and metrics.json's
 // cells unchanged, the record added); an edited frame that moves the light is the main
 // refiner's output with the emitter refiner's on the mask, computed here from the two files.
