@@ -238,8 +238,9 @@ inline std::optional<SamplerKind> sampler_choice(const std::string& name, const 
     return sampler_named(name, option);
 }
 
-/// The BSDF sample's random numbers at a depth: lobe choice and direction. Shared by the tracer
-/// and by path replay, which re-samples delta lobes (autodiff/path_record.cpp).
+/// The BSDF sample's random numbers at a depth: lobe choice and direction. Path replay re-samples
+/// delta lobes with them (autodiff/path_record.cpp); the tracer draws the same numbers for its
+/// whole shade queue at once (core/sample_batch.h).
 struct BsdfRandoms {
     float lobe;
     float dir[2];

@@ -6,6 +6,7 @@
 #include "integrators/path.h"
 #include "core/envmap.h"
 #include "core/sampler.h"
+#include "core/sample_batch.h"
 #include "core/warp.h"
 #include "integrators/latent_stage.h"
 #include "integrators/wavefront_state.h"
@@ -29,6 +30,7 @@ struct Workspace {
     ShadowQueue<N> shadow;
     ShadeQueue shade;
     AlignedVector<float> u_lobe, u_dir[2], cosine[3];  ///< per shade entry: BSDF randoms, warped direction
+    ShadeSampleKeys sample_keys;                       ///< per shade entry: for its random numbers
     AlignedVector<float> film[2];                      ///< per camera ray: pixel column and row
     LightBatch lights;                                 ///< per shade entry: the NEE light sample
     PathState<N> paths;
@@ -108,8 +110,8 @@ private:
             p.key[k] = rng.key;
             fx[k] = float(x);
             fy[k] = float(y);
-            rng.get2(dim::kFilter, u0[k], u1[k]);
         }
+        sample_batch(m_opt.sampler, p.key.data(), p.sample.data(), n, dim::kFilter, u0, u1);
         RayArrays& rays = ws.rays[0];
         rays.resize_for_fill(n);
         m_camera.generate_rays(n, fx, fy, u0, u1, m_camera.tan_half_fov(),
@@ -275,21 +277,26 @@ private:
         }
     }
 
+    /// The stage's random numbers in `dimension` (and the next, with u1) for every shade entry.
+    void draw(const Workspace<N>& ws, uint32_t dimension, float* u0, float* u1 = nullptr) const {
+        const ShadeSampleKeys& s = ws.sample_keys;
+        sample_batch(m_opt.sampler, s.key.data(), s.index.data(), s.key.size(), dimension, u0, u1);
+    }
+
     /// Every shade entry's light sample at once (core/light_sampler.h): per vertex it is a long
     /// dependent chain of square roots and divisions.
     void draw_light_samples(Workspace<N>& ws, int depth) const {
-        const PathState<N>& p = ws.paths;
         const ShadeQueue& sq = ws.shade;
         LightBatch& lb = ws.lights;
         lb.resize(sq.size());
         for (size_t k = 0; k < sq.size(); ++k) {
-            const SampleStream rng = SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler);
             lb.rx[k] = sq.p[k].x();
             lb.ry[k] = sq.p[k].y();
             lb.rz[k] = sq.p[k].z();
-            lb.u_choice[k] = rng.get(dim::bounce(depth, dim::kLightChoice));
-            rng.get2(dim::bounce(depth, dim::kLightPos), lb.u_pos0[k], lb.u_pos1[k]);
         }
+        ws.sample_keys.gather(ws.paths, ws.shade);
+        draw(ws, dim::bounce(depth, dim::kLightChoice), lb.u_choice.data());
+        draw(ws, dim::bounce(depth, dim::kLightPos), lb.u_pos0.data(), lb.u_pos1.data());
         m_scene.lights.sample_batch(m_scene.emitters, m_scene.shapes, sq.size(), lb);
     }
 
@@ -328,13 +335,9 @@ private:
         const size_t n = sq.size();
         for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0], &ws.cosine[1], &ws.cosine[2]})
             if (a->size() < n) a->resize(n);
-        for (size_t k = 0; k < n; ++k) {
-            const BsdfRandoms u = bsdf_randoms(
-                SampleStream::from_key(p.key[sq.slot[k]], p.sample[sq.slot[k]], m_opt.sampler), uint32_t(depth));
-            ws.u_lobe[k] = u.lobe;
-            ws.u_dir[0][k] = u.dir[0];
-            ws.u_dir[1][k] = u.dir[1];
-        }
+        ws.sample_keys.gather(ws.paths, ws.shade);  // bsdf_randoms for the whole queue
+        draw(ws, dim::bounce(depth, dim::kBsdfLobe), ws.u_lobe.data());
+        draw(ws, dim::bounce(depth, dim::kBsdfDir), ws.u_dir[0].data(), ws.u_dir[1].data());
         sample_cosine_hemisphere_batch(ws.u_dir[0].data(), ws.u_dir[1].data(), ws.cosine[0].data(), ws.cosine[1].data(),
                                        ws.cosine[2].data(), n);
         for (size_t k = 0; k < n; ++k) {

@@ -92,6 +92,22 @@ struct ShadeQueue {
     size_t size() const { return count; }
 };
 
+/// Each shade entry's sample key and index side by side (its path's, through `slot`): what
+/// sample_batch (core/sample_batch.h) draws a stage's random numbers from for the whole queue.
+struct ShadeSampleKeys {
+    std::vector<uint64_t> key;
+    std::vector<uint32_t> index;
+    template <int N>
+    void gather(const PathState<N>& p, const ShadeQueue& sq) {
+        key.resize(sq.size());
+        index.resize(sq.size());
+        for (size_t k = 0; k < sq.size(); ++k) {
+            key[k] = p.key[sq.slot[k]];
+            index[k] = p.sample[sq.slot[k]];
+        }
+    }
+};
+
 /// Shadow rays of next-event estimation with the contribution each delivers if unblocked.
 template <int N>
 struct ShadowQueue {
