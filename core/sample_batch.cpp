@@ -34,21 +34,14 @@ void both_coordinates(const uint64_t* keys, const uint32_t* indices, size_t n, u
     }
 }
 
+/// Coordinate c of the pair alone: SobolPairPoint::coordinate(c).
 LPT_VECTOR_CLONES
-void first_coordinate(const uint64_t* keys, const uint32_t* indices, size_t n, uint64_t pair_mix, float* u) {
+void one_coordinate(const uint64_t* keys, const uint32_t* indices, size_t n, uint64_t pair_mix, uint32_t c, float* u) {
+    const uint32_t seed_offset = c ? kSecondSeed : 0u;
 #pragma GCC ivdep
     for (size_t k = 0; k < n; ++k) {
         const PairWord w = pair_word(keys[k], pair_mix, indices[k]);
-        u[k] = scrambled_fraction(w.z0, w.seed);
-    }
-}
-
-LPT_VECTOR_CLONES
-void second_coordinate(const uint64_t* keys, const uint32_t* indices, size_t n, uint64_t pair_mix, float* u) {
-#pragma GCC ivdep
-    for (size_t k = 0; k < n; ++k) {
-        const PairWord w = pair_word(keys[k], pair_mix, indices[k]);
-        u[k] = scrambled_fraction(sobol_dimension1_unreversed(w.z0), w.seed ^ kSecondSeed);
+        u[k] = scrambled_fraction(c ? sobol_dimension1_unreversed(w.z0) : w.z0, w.seed ^ seed_offset);
     }
 }
 
@@ -62,10 +55,8 @@ void sobol_batch(const uint64_t* keys, const uint32_t* indices, size_t n, uint32
             throw std::logic_error("sobol_batch: dimensions " + std::to_string(dimension) + " and " +
                                    std::to_string(dimension + 1) + " are not one pair");
         both_coordinates(keys, indices, n, pair_mix, u0, u1);
-    } else if (d.coordinate == 0) {
-        first_coordinate(keys, indices, n, pair_mix, u0);
     } else {
-        second_coordinate(keys, indices, n, pair_mix, u0);
+        one_coordinate(keys, indices, n, pair_mix, d.coordinate, u0);
     }
 }
 

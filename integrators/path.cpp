@@ -30,7 +30,6 @@ struct Workspace {
     ShadowQueue<N> shadow;
     ShadeQueue shade;
     AlignedVector<float> u_lobe, u_dir[2], cosine[3];  ///< per shade entry: BSDF randoms, warped direction
-    ShadeSampleKeys sample_keys;                       ///< per shade entry: for its random numbers
     AlignedVector<float> film[2];                      ///< per camera ray: pixel column and row
     LightBatch lights;                                 ///< per shade entry: the NEE light sample
     PathState<N> paths;
@@ -209,6 +208,8 @@ private:
             const size_t k = sq.count++;
             sq.flags[k] = flags;
             sq.slot[k] = slot;
+            sq.key[k] = p.key[slot];
+            sq.sample[k] = p.sample[slot];
             sq.shape[k] = shape_id;
             sq.p[k] = si.p;
             sq.ng[k] = si.ng;
@@ -278,9 +279,8 @@ private:
     }
 
     /// The stage's random numbers in `dimension` (and the next, with u1) for every shade entry.
-    void draw(const Workspace<N>& ws, uint32_t dimension, float* u0, float* u1 = nullptr) const {
-        const ShadeSampleKeys& s = ws.sample_keys;
-        sample_batch(m_opt.sampler, s.key.data(), s.index.data(), s.key.size(), dimension, u0, u1);
+    void draw(const ShadeQueue& sq, uint32_t dimension, float* u0, float* u1 = nullptr) const {
+        sample_batch(m_opt.sampler, sq.key.data(), sq.sample.data(), sq.size(), dimension, u0, u1);
     }
 
     /// Every shade entry's light sample at once (core/light_sampler.h): per vertex it is a long
@@ -294,9 +294,8 @@ private:
             lb.ry[k] = sq.p[k].y();
             lb.rz[k] = sq.p[k].z();
         }
-        ws.sample_keys.gather(ws.paths, ws.shade);
-        draw(ws, dim::bounce(depth, dim::kLightChoice), lb.u_choice.data());
-        draw(ws, dim::bounce(depth, dim::kLightPos), lb.u_pos0.data(), lb.u_pos1.data());
+        draw(sq, dim::bounce(depth, dim::kLightChoice), lb.u_choice.data());
+        draw(sq, dim::bounce(depth, dim::kLightPos), lb.u_pos0.data(), lb.u_pos1.data());
         m_scene.lights.sample_batch(m_scene.emitters, m_scene.shapes, sq.size(), lb);
     }
 
@@ -335,9 +334,8 @@ private:
         const size_t n = sq.size();
         for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0], &ws.cosine[1], &ws.cosine[2]})
             if (a->size() < n) a->resize(n);
-        ws.sample_keys.gather(ws.paths, ws.shade);  // bsdf_randoms for the whole queue
-        draw(ws, dim::bounce(depth, dim::kBsdfLobe), ws.u_lobe.data());
-        draw(ws, dim::bounce(depth, dim::kBsdfDir), ws.u_dir[0].data(), ws.u_dir[1].data());
+        draw(sq, dim::bounce(depth, dim::kBsdfLobe), ws.u_lobe.data());  // bsdf_randoms for the whole queue
+        draw(sq, dim::bounce(depth, dim::kBsdfDir), ws.u_dir[0].data(), ws.u_dir[1].data());
         sample_cosine_hemisphere_batch(ws.u_dir[0].data(), ws.u_dir[1].data(), ws.cosine[0].data(), ws.cosine[1].data(),
                                        ws.cosine[2].data(), n);
         for (size_t k = 0; k < n; ++k) {

@@ -70,6 +70,8 @@ struct PathState {
 /// their capacity across depths; `count` entries are live.
 struct ShadeQueue {
     std::vector<uint32_t> slot;
+    std::vector<uint64_t> key;     ///< its path's sample key and index, side by side for
+    std::vector<uint32_t> sample;  ///< sample_batch (core/sample_batch.h)
     std::vector<int> shape;
     AlignedVector<Vec3f> p, ng, wi;  ///< wi in the local shading frame
     std::vector<Frame> frame;
@@ -81,6 +83,8 @@ struct ShadeQueue {
         count = 0;
         if (slot.size() >= capacity) return;
         slot.resize(capacity);
+        key.resize(capacity);
+        sample.resize(capacity);
         shape.resize(capacity);
         p.resize(capacity);
         ng.resize(capacity);
@@ -90,22 +94,6 @@ struct ShadeQueue {
         flags.resize(capacity);
     }
     size_t size() const { return count; }
-};
-
-/// Each shade entry's sample key and index side by side (its path's, through `slot`): what
-/// sample_batch (core/sample_batch.h) draws a stage's random numbers from for the whole queue.
-struct ShadeSampleKeys {
-    std::vector<uint64_t> key;
-    std::vector<uint32_t> index;
-    template <int N>
-    void gather(const PathState<N>& p, const ShadeQueue& sq) {
-        key.resize(sq.size());
-        index.resize(sq.size());
-        for (size_t k = 0; k < sq.size(); ++k) {
-            key[k] = p.key[sq.slot[k]];
-            index[k] = p.sample[sq.slot[k]];
-        }
-    }
 };
 
 /// Shadow rays of next-event estimation with the contribution each delivers if unblocked.
