@@ -6,42 +6,27 @@ namespace lpt {
 
 namespace {
 
-/// The scrambled coordinate of SobolPairPoint::coordinate from its Sobol word z (bit-reversed).
-inline float scrambled_fraction(uint32_t z, uint32_t seed) {
-    return float(reverse_bits32(lk_hash(z, seed)) >> 8) * 0x1.0p-24f;
-}
-
-/// SobolPairPoint's pair hash and coordinate 0's Sobol word z0 = rev(shuffled_reversed);
-/// coordinate 1's is kSobolDimension1Reversed(shuffled_reversed) = sobol_dimension1_unreversed(z0).
-struct PairWord {
-    uint32_t z0, seed;
-};
-inline PairWord pair_word(uint64_t key, uint64_t pair_mix, uint32_t index) {
-    const uint64_t h = mix64(key ^ pair_mix);
-    return {reverse_bits32(lk_hash(reverse_bits32(index), uint32_t(h))), uint32_t(h >> 32)};
-}
-
-constexpr uint32_t kSecondSeed = 0x9e3779b9u;  // SobolPairPoint::coordinate(1)'s seed offset
-
+// Both loops compute SobolPairPoint::coordinate, with coordinate 1's Sobol word by
+// sobol_dimension1_unreversed instead of the table lookup, which GCC does not vectorise.
 LPT_VECTOR_CLONES
-void both_coordinates(const uint64_t* keys, const uint32_t* indices, size_t n, uint64_t pair_mix, float* u0,
-                      float* u1) {
+void both_coordinates(const uint64_t* keys, const uint32_t* indices, size_t n, uint32_t pair, float* u0, float* u1) {
 #pragma GCC ivdep
     for (size_t k = 0; k < n; ++k) {
-        const PairWord w = pair_word(keys[k], pair_mix, indices[k]);
-        u0[k] = scrambled_fraction(w.z0, w.seed);
-        u1[k] = scrambled_fraction(sobol_dimension1_unreversed(w.z0), w.seed ^ kSecondSeed);
+        const SobolPairPoint pt(keys[k], pair, reverse_bits32(indices[k]));
+        const uint32_t z0 = pt.word0();
+        u0[k] = SobolPairPoint::scrambled(z0, pt.seed(0));
+        u1[k] = SobolPairPoint::scrambled(sobol_dimension1_unreversed(z0), pt.seed(1));
     }
 }
 
 /// Coordinate c of the pair alone: SobolPairPoint::coordinate(c).
 LPT_VECTOR_CLONES
-void one_coordinate(const uint64_t* keys, const uint32_t* indices, size_t n, uint64_t pair_mix, uint32_t c, float* u) {
-    const uint32_t seed_offset = c ? kSecondSeed : 0u;
+void one_coordinate(const uint64_t* keys, const uint32_t* indices, size_t n, uint32_t pair, uint32_t c, float* u) {
 #pragma GCC ivdep
     for (size_t k = 0; k < n; ++k) {
-        const PairWord w = pair_word(keys[k], pair_mix, indices[k]);
-        u[k] = scrambled_fraction(c ? sobol_dimension1_unreversed(w.z0) : w.z0, w.seed ^ seed_offset);
+        const SobolPairPoint pt(keys[k], pair, reverse_bits32(indices[k]));
+        const uint32_t z0 = pt.word0();
+        u[k] = SobolPairPoint::scrambled(c ? sobol_dimension1_unreversed(z0) : z0, pt.seed(c));
     }
 }
 
@@ -49,14 +34,13 @@ void one_coordinate(const uint64_t* keys, const uint32_t* indices, size_t n, uin
 
 void sobol_batch(const uint64_t* keys, const uint32_t* indices, size_t n, uint32_t dimension, float* u0, float* u1) {
     const DimensionPair d = dimension_pair(dimension);
-    const uint64_t pair_mix = uint64_t(d.pair) * 0xd1b54a32d192ed03ULL;
     if (u1) {
         if (d.coordinate != 0 || dimension_pair(dimension + 1).pair != d.pair)
             throw std::logic_error("sobol_batch: dimensions " + std::to_string(dimension) + " and " +
                                    std::to_string(dimension + 1) + " are not one pair");
-        both_coordinates(keys, indices, n, pair_mix, u0, u1);
+        both_coordinates(keys, indices, n, d.pair, u0, u1);
     } else {
-        one_coordinate(keys, indices, n, pair_mix, d.coordinate, u0);
+        one_coordinate(keys, indices, n, d.pair, d.coordinate, u0);
     }
 }
 

@@ -146,10 +146,16 @@ struct SobolPairPoint {
     SobolPairPoint(uint64_t pixel_key, uint32_t pair, uint32_t reversed_index)
         : h(mix64(pixel_key ^ (uint64_t(pair) * 0xd1b54a32d192ed03ULL))),
           shuffled_reversed(lk_hash(reversed_index, uint32_t(h))) {}
-    float coordinate(uint32_t c) const {
-        const uint32_t z = c == 0 ? reverse_bits32(shuffled_reversed) : kSobolDimension1Reversed(shuffled_reversed);
-        const uint32_t seed = uint32_t(h >> 32) ^ (c ? 0x9e3779b9u : 0u);
+    /// Coordinate 0's Sobol word; coordinate 1's is kSobolDimension1Reversed(shuffled_reversed).
+    uint32_t word0() const { return reverse_bits32(shuffled_reversed); }
+    /// Coordinate c's scrambling seed.
+    uint32_t seed(uint32_t c) const { return uint32_t(h >> 32) ^ (c ? 0x9e3779b9u : 0u); }
+    /// Sobol word z, Owen-scrambled under `seed`, as a float in [0, 1).
+    static float scrambled(uint32_t z, uint32_t seed) {
         return float(reverse_bits32(lk_hash(z, seed)) >> 8) * 0x1.0p-24f;
+    }
+    float coordinate(uint32_t c) const {
+        return scrambled(c == 0 ? word0() : kSobolDimension1Reversed(shuffled_reversed), seed(c));
     }
 };
 
