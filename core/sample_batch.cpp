@@ -54,4 +54,10 @@ void sample_batch(SamplerKind kind, const uint64_t* keys, const uint32_t* indice
     }
 }
 
+void bsdf_randoms_batch(SamplerKind kind, const uint64_t* keys, const uint32_t* indices, size_t n, uint32_t depth,
+                        float* lobe, float* dir0, float* dir1) {
+    sample_batch(kind, keys, indices, n, dim::bounce(depth, dim::kBsdfLobe), lobe);
+    sample_batch(kind, keys, indices, n, dim::bounce(depth, dim::kBsdfDir), dir0, dir1);
+}
+
 }  // namespace lpt

@@ -40,4 +40,10 @@ void sobol_batch(const uint64_t* keys, const uint32_t* indices, size_t n, uint32
 void sample_batch(SamplerKind kind, const uint64_t* keys, const uint32_t* indices, size_t n, uint32_t dimension,
                   float* u0, float* u1 = nullptr);
 
+/// bsdf_randoms (core/sampler.h) for a whole shade queue: for k < n,
+///   lobe[k], dir0[k], dir1[k] = bsdf_randoms(SampleStream::from_key(keys[k], indices[k], kind), depth)
+/// so the tracer's BSDF stage and path replay read one layout of the stage's dimensions.
+void bsdf_randoms_batch(SamplerKind kind, const uint64_t* keys, const uint32_t* indices, size_t n, uint32_t depth,
+                        float* lobe, float* dir0, float* dir1);
+
 }  // namespace lpt

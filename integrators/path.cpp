@@ -334,8 +334,8 @@ private:
         const size_t n = sq.size();
         for (auto* a : {&ws.u_lobe, &ws.u_dir[0], &ws.u_dir[1], &ws.cosine[0], &ws.cosine[1], &ws.cosine[2]})
             if (a->size() < n) a->resize(n);
-        draw(sq, dim::bounce(depth, dim::kBsdfLobe), ws.u_lobe.data());  // bsdf_randoms for the whole queue
-        draw(sq, dim::bounce(depth, dim::kBsdfDir), ws.u_dir[0].data(), ws.u_dir[1].data());
+        bsdf_randoms_batch(m_opt.sampler, sq.key.data(), sq.sample.data(), n, uint32_t(depth), ws.u_lobe.data(),
+                           ws.u_dir[0].data(), ws.u_dir[1].data());
         sample_cosine_hemisphere_batch(ws.u_dir[0].data(), ws.u_dir[1].data(), ws.cosine[0].data(), ws.cosine[1].data(),
                                        ws.cosine[2].data(), n);
         for (size_t k = 0; k < n; ++k) {

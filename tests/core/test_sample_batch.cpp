@@ -65,3 +65,27 @@ TEST(SampleBatch, BothCoordinatesOnlyOfOnePair) {
     EXPECT_THROW(sobol_batch(&key, &index, 1, dim::bounce(0, dim::kLightChoice), &u0, &u1), std::logic_error);
     EXPECT_EQ(u0, -1.f);
 }
+
+// The tracer's BSDF stage draws bsdf_randoms_batch; path replay re-samples delta lobes from
+// bsdf_randoms: both must read the stage's dimensions in one layout.
+TEST(SampleBatch, BsdfRandomsBatchEqualsTheOneSampleForm) {
+    std::mt19937_64 rng(5);
+    const size_t n = 37;
+    for (const SamplerKind kind : {SamplerKind::Sobol, SamplerKind::Independent})
+        for (uint32_t depth = 0; depth < 4; ++depth) {
+            std::vector<uint64_t> keys(n);
+            std::vector<uint32_t> indices(n);
+            for (size_t k = 0; k < n; ++k) {
+                indices[k] = uint32_t(rng());
+                keys[k] = SampleStream(rng(), uint32_t(rng()), indices[k], kind).key;
+            }
+            std::vector<float> lobe(n, -1.f), dir0(n, -1.f), dir1(n, -1.f);
+            bsdf_randoms_batch(kind, keys.data(), indices.data(), n, depth, lobe.data(), dir0.data(), dir1.data());
+            for (size_t k = 0; k < n; ++k) {
+                const BsdfRandoms u = bsdf_randoms(SampleStream::from_key(keys[k], indices[k], kind), depth);
+                ASSERT_EQ(lobe[k], u.lobe) << "depth " << depth << ", sample " << k;
+                ASSERT_EQ(dir0[k], u.dir[0]) << "depth " << depth << ", sample " << k;
+                ASSERT_EQ(dir1[k], u.dir[1]) << "depth " << depth << ", sample " << k;
+            }
+        }
+}
