@@ -4,7 +4,8 @@
 which drives the latentpt binary. Local by default (--cores); --slurm submits every job to a
 Slurm cluster instead. A stopped run continues where it stopped when started again with the
 same flags: finished jobs are kept, killed ones resume (fits from their checkpoint, edit
-sequences from their last finished frame).
+sequences from their last finished frame). It prints how far the run is and about how long it
+has left when it starts and after each job (scripts/experiment_progress.py).
 
 For each scene: three stage-1 fits to the TAESD3-encoded RGB reference (terms e, ea, eac; the
 eac fit also trains the refiner), then every edit sequence scenes/<scene>/edits-<kind>.json
@@ -41,10 +42,12 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import experiment_lib as X  # noqa: E402
+import experiment_progress as P  # noqa: E402
 
 
 def snakemake_command(a, config_path, out):
@@ -70,7 +73,18 @@ def snakemake_command(a, config_path, out):
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
-def run_workflow(cmd, lock):
+def report_progress(progress, stop, every=15.0):
+    """Until `stop` is set: after each finished job, a line of how far the run is and about how
+    long it has left (scripts/experiment_progress.py)."""
+    seen = len(progress.finished())
+    while not stop.wait(every):
+        n = len(progress.finished())
+        if n != seen:
+            seen = n
+            print(progress.line(), file=sys.stderr, flush=True)
+
+
+def run_workflow(cmd, lock, progress=None):
     """Run Snakemake in a process group of its own and return (its exit status, the stop signal
     received or None). A SIGINT, SIGTERM or SIGHUP to this process reaches the whole group as the
     SIGINT of a terminal's Ctrl-C: running jobs stop where they are (killed jobs resume on the next
@@ -95,6 +109,7 @@ def run_workflow(cmd, lock):
 
     # Handlers first: a signal that comes while Snakemake starts must not end this process alone.
     before = {s: signal.signal(s, forward) for s in STOP_SIGNALS}
+    reporting = threading.Event()
     try:
         # A process group, not a session: a new session is also a new scheduler autogroup on
         # Linux. With one, experiment.quick beside four other tests (ctest -j2) took 336 s, with
@@ -103,8 +118,11 @@ def run_workflow(cmd, lock):
         group.append(p.pid)
         if received:  # arrived before the group existed
             stop(signal.SIGINT)
+        if progress:
+            threading.Thread(target=report_progress, args=(progress, reporting), daemon=True).start()
         returncode = p.wait()
     finally:
+        reporting.set()
         for s, handler in before.items():
             signal.signal(s, handler)
     return returncode, (received[0] if received else None)
@@ -181,7 +199,11 @@ def main():
     config_path = os.path.join(c["out"], "experiment-config.json")
     X.write_atomic(config_path, json.dumps(c, indent=1))
     started = time.time()
-    returncode, stopped_by = run_workflow(snakemake_command(a, config_path, c["out"]), lock)
+    # Locally one job runs at a time (each takes every core), so the jobs' times add up to the
+    # run's; on Slurm they overlap, and the line says job time only.
+    progress = P.Progress(c, c["out"], started, clock=not a.slurm)
+    print(progress.line(), file=sys.stderr, flush=True)
+    returncode, stopped_by = run_workflow(snakemake_command(a, config_path, c["out"]), lock, progress)
     if stopped_by is not None:
         print(f"experiment: stopped by {signal.Signals(stopped_by).name}; finished jobs are kept in {c['out']}: "
               "run again with the same flags to continue", file=sys.stderr)
@@ -191,6 +213,7 @@ def main():
                  "run again with the same flags to continue")
     if "--dry-run" in a.snakemake_args or "-n" in a.snakemake_args:
         return 0
+    print(progress.line(), file=sys.stderr, flush=True)  # the last job's line: the workflow has ended
     summary = os.path.join(c["out"], "summary.md")
     if not os.path.exists(summary):  # targets named after -- that leave the summary out
         print(f"experiment: the named targets are done; no {summary} yet (the whole workflow writes it)")
