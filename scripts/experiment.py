@@ -201,9 +201,10 @@ def main():
     started = time.time()
     # Locally one job runs at a time (each takes every core), so the jobs' times add up to the
     # run's; on Slurm they overlap, and the line says job time only.
-    progress = P.Progress(c, c["out"], started, clock=not a.slurm)
+    cmd = snakemake_command(a, config_path, c["out"])
+    progress = P.Progress(c, c["out"], started, P.pending_jobs(cmd), clock=not a.slurm)
     print(progress.line(), file=sys.stderr, flush=True)
-    returncode, stopped_by = run_workflow(snakemake_command(a, config_path, c["out"]), lock, progress)
+    returncode, stopped_by = run_workflow(cmd, lock, progress)
     if stopped_by is not None:
         print(f"experiment: stopped by {signal.Signals(stopped_by).name}; finished jobs are kept in {c['out']}: "
               "run again with the same flags to continue", file=sys.stderr)

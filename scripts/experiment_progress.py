@@ -6,9 +6,13 @@ model of its work: RGB samples traced, refiner steps and inference windows, fram
 scored. The model's constants are seconds on one reference machine (the slow 2-core AMD EPYC of
 sessions 38-40, idle); a run rescales them by the ratio of its finished jobs' measured times to
 their modelled ones, so a faster or slower machine gets its own estimate after its first jobs.
-A job is finished when its benchmark file exists: Snakemake writes it when the job ends."""
+The jobs a run will do are those Snakemake's dry run of the same command lists (targets,
+--config and --forcerun after `--` included); a job is finished once it has written its
+benchmark file, which Snakemake does when the job ends."""
 import csv
 import os
+import re
+import subprocess
 import time
 
 import experiment_lib as X
@@ -121,6 +125,18 @@ def planned_jobs(c):
     return jobs
 
 
+def pending_jobs(snakemake_cmd):
+    """The benchmark files (relative to the run's folder) of the jobs Snakemake would run for this
+    command: its dry run's plan. None if the dry run fails (the run itself will say why)."""
+    try:
+        out = subprocess.run(snakemake_cmd + ["--dry-run"], capture_output=True, text=True, timeout=600)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    if out.returncode != 0:
+        return None
+    return set(re.findall(r"^\s*benchmark: (\S+)$", out.stdout + out.stderr, re.M))
+
+
 def measured_s(path):
     """A job's wall seconds from its Snakemake benchmark file."""
     with open(path) as f:
@@ -129,31 +145,47 @@ def measured_s(path):
 
 class Progress:
     """The run's state: `line()` says how far it is and, from the jobs finished so far, how long it
-    has left. `since`: when this invocation began; jobs finished before it (an earlier, stopped
-    run's) count as done, and calibrate the model only while none of this run's has finished."""
+    has left. `since`: when this invocation began. `pending`: the benchmark files of the jobs it
+    will run (pending_jobs; None: every planned job without one). A pending job is finished once
+    it has written its file after `since` (Snakemake reruns jobs whose settings changed, over
+    their old files); the other planned jobs with a file are an earlier run's, done, and
+    calibrate the model only while none of this run's has finished."""
 
-    def __init__(self, c, out, since, clock=True):
-        self.jobs, self.out, self.since, self.clock = planned_jobs(c), out, since, clock
+    def __init__(self, c, out, since, pending=None, clock=True):
+        self.model, self.out, self.since, self.clock = dict(planned_jobs(c)), out, since, clock
+        self.pending = set(pending) if pending is not None else {r for r in self.model if not self._measured(r)}
+        self.typical = sum(self.model.values()) / max(1, len(self.model))  # a pending job the model lacks
+
+    def _cost(self, rel):
+        return self.model.get(rel, self.typical)
+
+    def _measured(self, rel, after=None):
+        """The job's measured seconds if its benchmark file exists (written after `after`), else None."""
+        path = os.path.join(self.out, rel)
+        try:
+            if after is not None and os.path.getmtime(path) < after:
+                return None
+            return measured_s(path)
+        except (OSError, ValueError, KeyError):  # not there yet, or being written
+            return None
 
     def finished(self):
-        """{benchmark path: (measured seconds, finished in this invocation)} of the finished jobs."""
+        """{benchmark path: (measured seconds, finished in this invocation)} of the done jobs."""
         done = {}
-        for rel, _ in self.jobs:
-            path = os.path.join(self.out, rel)
-            try:
-                done[rel] = (measured_s(path), os.path.getmtime(path) >= self.since)
-            except (OSError, ValueError, KeyError):  # not there yet, or being written
-                continue
+        for rel in self.pending | set(self.model):
+            s = self._measured(rel, self.since if rel in self.pending else None)
+            if s is not None:
+                done[rel] = (s, rel in self.pending)
         return done
 
     def estimate(self):
         """(jobs done, jobs in all, measured seconds done, modelled seconds left × scale, scale)."""
         done = self.finished()
-        model = dict(self.jobs)
         ours = [rel for rel, (_, now) in done.items() if now] or list(done)
-        scale = sum(done[r][0] for r in ours) / sum(model[r] for r in ours) if ours else 1.0
-        left = sum(s for rel, s in self.jobs if rel not in done)
-        return len(done), len(self.jobs), sum(s for s, _ in done.values()), left * scale, scale
+        scale = sum(done[r][0] for r in ours) / sum(self._cost(r) for r in ours) if ours else 1.0
+        left = sum(self._cost(rel) for rel in self.pending if rel not in done)
+        total = len(done) + len(self.pending - set(done))
+        return len(done), total, sum(s for s, _ in done.values()), left * scale, scale
 
     def line(self, now=None):
         n, total, done_s, left_s, scale = self.estimate()

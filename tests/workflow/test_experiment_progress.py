@@ -7,7 +7,6 @@ import json
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -20,16 +19,13 @@ import experiment_lib as X  # noqa: E402
 import experiment_progress as P  # noqa: E402
 
 
-def snakemake_benchmarks(c, folder):
-    """The benchmark files of every job Snakemake would run for config c from an empty folder."""
+def snakemake_command(c, folder):
+    """A Snakemake command of config c in `folder`, as experiment.py's (without its lock)."""
     config = os.path.join(folder, "config.json")
     with open(config, "w") as f:
         json.dump(c, f)
-    snakefile = os.path.join(ROOT, "workflow", "Snakefile")
-    out = subprocess.run(["snakemake", "--snakefile", snakefile, "--directory", folder, "--configfile", config,
-                          "--dry-run", "--forceall", "--cores", "2"],
-                         capture_output=True, text=True, check=True)
-    return sorted(re.findall(r"^\s*benchmark: (\S+)$", out.stdout + out.stderr, re.M))
+    return ["snakemake", "--snakefile", os.path.join(ROOT, "workflow", "Snakefile"), "--directory", folder,
+            "--configfile", config, "--cores", "2", "--nolock"]
 
 
 def write_benchmark(path, seconds, mtime):
@@ -47,9 +43,21 @@ class JobList(unittest.TestCase):
                    "full, every 6th frame": X.settings(frame_step=6)}
         for label, c in configs.items():
             with self.subTest(label), tempfile.TemporaryDirectory() as d:
-                want = snakemake_benchmarks(c, d)
+                want = P.pending_jobs(snakemake_command(c, d) + ["--forceall"])
                 self.assertGreater(len(want), 10)
-                self.assertEqual(sorted(rel for rel, _ in P.planned_jobs(c)), want)
+                self.assertEqual(sorted(rel for rel, _ in P.planned_jobs(c)), sorted(want))
+
+    @unittest.skipUnless(shutil.which("snakemake"), "snakemake not installed")
+    def test_a_narrowed_run_plans_its_own_jobs(self):
+        # `-- --config 'fits=[eac]'` (docs/workflow.md): the e and ea fits' jobs are not the run's
+        c = X.settings(paper=True, scenes=["veach-bidir"])
+        with tempfile.TemporaryDirectory() as d:
+            pending = P.pending_jobs(snakemake_command(c, d) + ["--config", "fits=[eac]"])
+            narrowed = {rel for rel, _ in P.planned_jobs(c) if not re.search(r"_(e|ea)[_.]", rel)}
+            self.assertIn("veach-bidir/benchmarks/fit_eac.tsv", narrowed)
+            self.assertEqual(pending, narrowed)
+            self.assertEqual(P.Progress(c, d, time.time(), pending).estimate()[:2], (0, len(pending)))
+            self.assertIsNone(P.pending_jobs(snakemake_command(c, d) + ["--no-such-option"]))
 
     def test_every_job_costs_something_and_references_cost_the_eac_chunks(self):
         c = X.settings(paper=True)
@@ -77,9 +85,10 @@ class TimeLeft(unittest.TestCase):
         since = time.time() - 100
         earlier, mine = self.jobs[0], self.jobs[1:4]
         write_benchmark(os.path.join(self.dir, earlier[0]), 10 * earlier[1], since - 1000)  # a stopped run's job
+        pending = [rel for rel, _ in self.jobs[1:]]  # the dry run's plan at the start
         for rel, s in mine:
             write_benchmark(os.path.join(self.dir, rel), 2 * s, since + 50)
-        n, total, done_s, left_s, scale = P.Progress(self.c, self.dir, since).estimate()
+        n, total, done_s, left_s, scale = P.Progress(self.c, self.dir, since, pending).estimate()
         self.assertEqual((n, total), (4, len(self.jobs)))
         self.assertAlmostEqual(scale, 2.0, places=3)
         self.assertAlmostEqual(left_s, 2 * sum(s for _, s in self.jobs[4:]), delta=1e-3)
@@ -90,6 +99,17 @@ class TimeLeft(unittest.TestCase):
         write_benchmark(os.path.join(self.dir, rel), 3 * s, time.time() - 1000)
         self.assertAlmostEqual(P.Progress(self.c, self.dir, time.time()).estimate()[4], 3.0, places=3)
         self.assertAlmostEqual(P.Progress(self.c, os.path.join(self.dir, "empty"), time.time()).estimate()[4], 1.0)
+
+    def test_a_rerun_job_is_pending_until_it_writes_its_file_again(self):
+        since = time.time()
+        (rel, s), = self.jobs[:1]
+        write_benchmark(os.path.join(self.dir, rel), s, since - 1000)  # an old run's; its settings changed
+        p = P.Progress(self.c, self.dir, since, [rel])
+        self.assertEqual(p.estimate()[:2], (0, 1))
+        self.assertAlmostEqual(p.estimate()[3], s, delta=1e-6)
+        write_benchmark(os.path.join(self.dir, rel), 4 * s, since + 10)
+        self.assertEqual(p.estimate()[:2], (1, 1))
+        self.assertAlmostEqual(p.estimate()[4], 4.0, places=3)
 
     def test_lines(self):
         p = P.Progress(self.c, self.dir, time.time())
