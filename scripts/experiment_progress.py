@@ -17,16 +17,23 @@ import time
 
 import experiment_lib as X
 
-# Seconds per RGB pixel-sample of each scene's path tracer on 2 threads (a 32-spp render; the
-# latent renderer's 16-wide samples cost LATENT_FACTOR times as much).
-TRACE_S = {"cbox-specular": 7.8e-7, "veach-bidir": 1.05e-6, "dining-room": 1.98e-6}
+# Seconds per RGB pixel-sample of each scene's path tracer on 2 threads (32-spp renders, less the
+# scene's loading; the latent renderer's 16-wide samples cost LATENT_FACTOR times as much), and
+# seconds to load the scene (dining-room's 270k triangles), once per job.
+TRACE_S = {"cbox-specular": 7.8e-7, "veach-bidir": 1.05e-6, "dining-room": 1.8e-6}
+LOAD_S = {"dining-room": 3.0}
 LATENT_FACTOR = 1.5
 SCORE_S_PER_PIXEL = 1.15e-5  # one frame decoded, scored (LPIPS, SSIM) and written, per RGB pixel
 WINDOW_S = 0.04  # the refiner on one 32² latent window (inference, width 256)
 WINDOW, WINDOW_STRIDE = 32, 4  # the refiner's inference windows (refiner/refiner_net.cpp)
 REFINER_STEP_S = 0.165  # one training step of the main refiner
 EMITTER_REFINER_S = 90.0  # `refine --emitters`' 3000 steps at expansion 4, with its renders
-JOB_S = 5.0  # start-up: binary, plugins, scene, networks
+JOB_S = 8.0  # start-up: binary, plugins, networks, fit folder
+
+
+def start_s(scene):
+    """A job's start-up on this scene."""
+    return JOB_S + LOAD_S.get(scene, 0.0)
 
 
 def trace_s(scene, res, spp):
@@ -68,7 +75,7 @@ def fit_s(c, scene, name):
     res = X.image_res_of(c, scene)
     # stored-path replay (docs/path-replay.md) brings an iteration's 16-wide latent sample down to
     # about the cost of one RGB sample: measured on the three scenes' e and ea fits
-    s = JOB_S + 10.0 + trace_s(scene, res // 8, 4 * c["fit_iterations"]) + score_s(res)
+    s = start_s(scene) + 10.0 + trace_s(scene, res // 8, 4 * c["fit_iterations"]) + score_s(res)
     if X.FITS[name][2]:
         s += c["refiner_iterations"] * REFINER_STEP_S + 3 * score_s(res) + 10.0
         s += EMITTER_REFINER_S if c.get("refiner_emitters") else 0.0
@@ -79,7 +86,7 @@ def edit_chunk_s(c, scene, kind, name, first, last):
     """A chunk of a sequence: its frames, and in the eac fit's job their references but frame 0's
     (the training view's, traced by the training-reference job)."""
     frames = [f for f in X.frames_evaluated(c, scene, kind) if first <= f <= last]
-    s = JOB_S + len(frames) * frame_s(c, scene, name, c["spp"])
+    s = start_s(scene) + len(frames) * frame_s(c, scene, name, c["spp"])
     if name == "eac":
         s += sum(reference_s(c, scene, X.ref_spp_of(c, scene)) for f in frames if f != 0)
     return s
@@ -90,7 +97,7 @@ def equal_error_s(c, scene):
     it, each encoded or decoded."""
     res, top = X.image_res_of(c, scene), c.get("equal_error_max_spp", 1024)
     levels = top.bit_length() + max(1, (top // 4).bit_length())
-    return JOB_S + trace_s(scene, res, 2 * top - 1) + levels * score_s(res) / 3
+    return start_s(scene) + trace_s(scene, res, 2 * top - 1) + levels * score_s(res) / 3
 
 
 def planned_jobs(c):
@@ -101,7 +108,7 @@ def planned_jobs(c):
         res = X.image_res_of(c, scene)
         b = os.path.join(scene, "benchmarks")
         jobs.append((os.path.join(b, "reference_training.tsv"),
-                     JOB_S + trace_s(scene, res, X.training_ref_spp_of(c, scene)) + score_s(res)))
+                     start_s(scene) + trace_s(scene, res, X.training_ref_spp_of(c, scene)) + score_s(res)))
         for name in X.fits_of(c):
             jobs.append((os.path.join(b, f"fit_{name}.tsv"), fit_s(c, scene, name)))
             for kind in X.KINDS:
@@ -110,7 +117,7 @@ def planned_jobs(c):
                                  edit_chunk_s(c, scene, kind, name, first, last)))
         for view in c.get("conv_views", ["training", "novel"]):
             for i, spp in enumerate(c["spp_list"]):
-                s = JOB_S + frame_s(c, scene, "eac", spp)
+                s = start_s(scene) + frame_s(c, scene, "eac", spp)
                 if view != "training" and i == 0:  # the first spp's job traces the view's reference
                     s += reference_s(c, scene, X.ref_spp_of(c, scene))
                 jobs.append((os.path.join(b, f"conv_{view}_{spp}.tsv"), s))
@@ -119,9 +126,9 @@ def planned_jobs(c):
             for kind in X.KINDS:
                 frames = [f for f in X.frames_evaluated(c, scene, kind) if kind == "camera" or f != 0]
                 per_frame = frame_s(c, scene, "eac", c["spp"]) + reference_s(c, scene, X.ref_spp_of(c, scene))
-                jobs.append((os.path.join(b, f"noise_{kind}.tsv"), JOB_S + len(frames) * per_frame))
+                jobs.append((os.path.join(b, f"noise_{kind}.tsv"), start_s(scene) + len(frames) * per_frame))
             scored = len(X.KINDS) * len(X.frames_evaluated(c, scene, X.KINDS[0])) * (len(X.fits_of(c)) + 1)
-            jobs.append((os.path.join(b, "noise_scores.tsv"), JOB_S + scored * score_s(res) / 2))
+            jobs.append((os.path.join(b, "noise_scores.tsv"), start_s(scene) + scored * score_s(res) / 2))
     return jobs
 
 
