@@ -587,15 +587,19 @@ STAGES = {"fit": "fits", "edit": "edits (references + renders)", "conv": "conver
           "noise": "second references (+ their scores)"}
 
 
+def benchmark_seconds(path):
+    """A job's wall seconds from its Snakemake benchmark file."""
+    with open(path) as f:
+        return sum(float(r["s"]) for r in csv.DictReader(f, delimiter="\t"))
+
+
 def job_times(out, scene):
     """Seconds per stage summed over the scene's jobs (Snakemake's benchmark files)."""
     times = {}
     bdir = os.path.join(out, scene, "benchmarks")
     for name in sorted(os.listdir(bdir)) if os.path.isdir(bdir) else []:
-        with open(os.path.join(bdir, name)) as f:
-            rows = list(csv.DictReader(f, delimiter="\t"))
         stage = STAGES.get(name.split("_")[0], name.split("_")[0])
-        times[stage] = times.get(stage, 0.0) + sum(float(r["s"]) for r in rows)
+        times[stage] = times.get(stage, 0.0) + benchmark_seconds(os.path.join(bdir, name))
     return times
 
 

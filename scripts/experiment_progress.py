@@ -9,7 +9,6 @@ their modelled ones, so a faster or slower machine gets its own estimate after i
 The jobs a run will do are those Snakemake's dry run of the same command lists (targets,
 --config and --forcerun after `--` included); a job is finished once it has written its
 benchmark file, which Snakemake does when the job ends."""
-import csv
 import os
 import re
 import subprocess
@@ -144,12 +143,6 @@ def pending_jobs(snakemake_cmd):
     return set(re.findall(r"^\s*benchmark: (\S+)$", out.stdout + out.stderr, re.M))
 
 
-def measured_s(path):
-    """A job's wall seconds from its Snakemake benchmark file."""
-    with open(path) as f:
-        return sum(float(r["s"]) for r in csv.DictReader(f, delimiter="\t"))
-
-
 class Progress:
     """The run's state: `line()` says how far it is and, from the jobs finished so far, how long it
     has left. `since`: when this invocation began. `pending`: the benchmark files of the jobs it
@@ -172,7 +165,7 @@ class Progress:
         try:
             if after is not None and os.path.getmtime(path) < after:
                 return None
-            return measured_s(path)
+            return X.benchmark_seconds(path)
         except (OSError, ValueError, KeyError):  # not there yet, or being written
             return None
 
