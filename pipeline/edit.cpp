@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 namespace lpt::pipeline {
 
@@ -67,9 +68,10 @@ std::string metrics_header(bool refined) {
 }
 
 /// One frame's errors against the encoded reference (docs/metrics.md): latent MSE, PSNR over the
-/// data range 6, D-SSIM = 1 − SSIM (range 6); decoded RGB (clamped to [0, 1]) MSE × 100, SSIM,
-/// LPIPS against the display-mapped reference. Empty where the image is below a metric's size.
-std::string frame_metrics(const std::vector<float>& latent, const std::vector<float>& ref,
+/// data range 6, D-SSIM = 1 − SSIM (range 6); the latent's decoded RGB `rgb` (empty without a VAE;
+/// clamped here to [0, 1]) MSE × 100, SSIM, LPIPS against the display-mapped reference. Empty where
+/// the image is below a metric's size.
+std::string frame_metrics(const std::vector<float>& latent, std::vector<float> rgb, const std::vector<float>& ref,
                           const std::vector<float>& ref_rgb, int w, int h, const Tools& t) {
     const double mse = mse_loss(latent.data(), ref.data(), ref.size());
     std::ostringstream o;
@@ -77,11 +79,10 @@ std::string frame_metrics(const std::vector<float>& latent, const std::vector<fl
     if (w >= kSsimWindow && h >= kSsimWindow)
         o << 1.0 - ssim(latent.data(), ref.data(), w, h, kLatentChannels, kLatentDataRange);
     o << ",";
-    if (!t.vae) {
+    if (rgb.empty()) {
         o << ",,";
         return o.str();
     }
-    std::vector<float> rgb = t.vae->decode(latent, w, h);
     for (float& v : rgb) v = std::clamp(v, 0.f, 1.f);
     o << 100.0 * mse_loss(rgb.data(), ref_rgb.data(), rgb.size()) << ",";
     if (8 * w >= kSsimWindow && 8 * h >= kSsimWindow) o << ssim(rgb.data(), ref_rgb.data(), 8 * w, 8 * h, 3, 1.0);
@@ -126,19 +127,24 @@ std::string render_frame(const EditJob& job, EditSession& session, const Tools& 
         write_refiner_aovs(stem + "_aov.exr", f.view);
         write_latent(stem + "_refined.exr", w, h, refined);
     }
+    // Each latent is decoded once (~5 s at 1024² on 2 cores): the picture and the scores read it.
+    std::vector<float> rgb, refined_rgb;
     if (t.vae) {
         // frame_NNNN.png is the result (refined when there is a refiner); _rendered.png the unrefined one.
-        write_png_display(stem + (refiner ? "_rendered.png" : ".png"),
-                          Image{8 * w, 8 * h, 3, t.vae->decode(latent, w, h), {}});
-        if (refiner) write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, t.vae->decode(refined, w, h), {}});
+        rgb = t.vae->decode(latent, w, h);
+        write_png_display(stem + (refiner ? "_rendered.png" : ".png"), Image{8 * w, 8 * h, 3, rgb, {}});
+        if (refiner) {
+            refined_rgb = t.vae->decode(refined, w, h);
+            write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, refined_rgb, {}});
+        }
     }
     if (!job.reference) return {};
     std::vector<float> ref_rgb;
     const std::vector<float> ref = frame_reference(job, session.fit(), t, i, name,
                                                    session.unedited(i) && job.defines.empty(), stem, w, h, ref_rgb);
     std::ostringstream row;
-    row << i << "," << session.time(i) << frame_metrics(latent, ref, ref_rgb, w, h, t);
-    if (refiner) row << frame_metrics(refined, ref, ref_rgb, w, h, t);
+    row << i << "," << session.time(i) << frame_metrics(latent, std::move(rgb), ref, ref_rgb, w, h, t);
+    if (refiner) row << frame_metrics(refined, std::move(refined_rgb), ref, ref_rgb, w, h, t);
     return row.str();
 }
 

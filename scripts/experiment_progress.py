@@ -22,7 +22,8 @@ import experiment_lib as X
 TRACE_S = {"cbox-specular": 7.8e-7, "veach-bidir": 1.05e-6, "dining-room": 1.8e-6}
 LOAD_S = {"dining-room": 3.0}
 LATENT_FACTOR = 1.5
-SCORE_S_PER_PIXEL = 1.15e-5  # one frame decoded, scored (LPIPS, SSIM) and written, per RGB pixel
+SCORE_S_PER_PIXEL = 1.15e-5  # an image decoded or encoded, scored (LPIPS, SSIM) and written, per RGB pixel
+FRAME_SCORE_S_PER_PIXEL = 6.2e-6  # one latent of a `render --edit` frame, decoded once, scored and written
 WINDOW_S = 0.04  # the refiner on one 32² latent window (inference, width 256)
 WINDOW, WINDOW_STRIDE = 32, 4  # the refiner's inference windows (refiner/refiner_net.cpp)
 REFINER_STEP_S = 0.165  # one training step of the main refiner
@@ -43,6 +44,10 @@ def score_s(res):
     return SCORE_S_PER_PIXEL * res * res
 
 
+def frame_score_s(res):
+    return FRAME_SCORE_S_PER_PIXEL * res * res
+
+
 def windows(latent):
     """Inference windows over a latent side (refiner_net.cpp's window_origins), squared."""
     if latent <= WINDOW:
@@ -53,13 +58,13 @@ def windows(latent):
 def refined_frame_s(res):
     """What a refined frame adds to a rendered one: both refiners' windows, the refined latent
     decoded and scored."""
-    return windows(res // 8) * WINDOW_S * 17 / 16 + 0.6 * score_s(res)
+    return windows(res // 8) * WINDOW_S * 17 / 16 + 0.6 * frame_score_s(res)
 
 
 def frame_s(c, scene, name, spp):
     """One frame of `render --edit`: the latent render, decoded and scored (and refined)."""
     res = X.image_res_of(c, scene)
-    s = LATENT_FACTOR * trace_s(scene, res // 8, spp) + score_s(res)
+    s = LATENT_FACTOR * trace_s(scene, res // 8, spp) + frame_score_s(res)
     return s + (refined_frame_s(res) if X.FITS[name][2] else 0.0)
 
 
