@@ -46,6 +46,7 @@ struct RenderArgs {
     int ref_spp = 256;
     uint64_t ref_seed = pipeline::kReferenceSeed;
     std::string reference_cache;  ///< folder keeping path-traced reference frames for reuse
+    std::string frame_cache;      ///< with edit: folder keeping the training view's frames for reuse
     std::string frames;           ///< with edit: "A:B", only frames A..B (inclusive)
     bool resume = false;          ///< with edit: skip frames an earlier run finished
 };

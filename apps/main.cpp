@@ -156,8 +156,9 @@ struct Cli {
                          "index); another traces independent references (cached apart), e.g. to measure their noise")
             ->capture_default_str();
         render->add_option("--reference-cache", r.reference_cache,
-                           "with --reference: keep path-traced frames in this folder and reuse them "
-                           "(keyed by edits file name, size, spp, tone and frame)");
+                           "with --reference: keep path-traced frames here and reuse them (keyed by settings, frame)");
+        render->add_option("--frame-cache", r.frame_cache,
+                           "with --edit: keep frames that show the training view (frame 0) here, for other sequences");
         render->add_option("--frames", r.frames,
                            "with --edit: only frames A:B (inclusive, from 0), or every S-th of them with A:B:S; split "
                            "jobs give the same frame files as one, and write metrics_A-B.csv");
@@ -312,8 +313,7 @@ struct Cli {
         fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")
             ->capture_default_str();
         fit->add_option("--reference-cache", f.job.reference_cache,
-                        "with --encode: keep the traced and encoded reference in this folder and reuse it (one "
-                        "folder per scene: fits of one scene share it)");
+                        "with --encode: keep the encoded reference here and reuse it (fits of one scene share it)");
         fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")
             ->check(CLI::IsMember({"clip", "reinhard"}))
             ->capture_default_str();

@@ -39,6 +39,7 @@ int run_render_edit(const RenderArgs& a) {
     job.ref_spp = a.ref_spp;
     job.ref_seed = a.ref_seed;
     job.reference_cache = a.reference_cache;
+    job.frame_cache = a.frame_cache;
     job.resume = a.resume;
     if (!a.frames.empty()) parse_frames(a.frames, job.first_frame, job.last_frame, job.frame_step);
     const int frames = pipeline::render_edits(job, console_reporter(a.quiet));

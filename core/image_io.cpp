@@ -179,4 +179,16 @@ void write_text_atomic(const std::string& path, const std::string& contents) {
     fs::rename(tmp, path);
 }
 
+void copy_file_atomic(const std::string& from, const std::string& to) {
+    if (fs::path(to).has_parent_path()) fs::create_directories(fs::path(to).parent_path());
+    const std::string tmp = temp_path_for(to);
+    std::error_code ec;
+    fs::copy_file(from, tmp, fs::copy_options::overwrite_existing, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw std::runtime_error(to + ": cannot copy " + from + " there");
+    }
+    fs::rename(tmp, to);
+}
+
 }  // namespace lpt

@@ -28,6 +28,8 @@ Image read_image(const std::string& path);
 std::string read_file(const std::string& path);
 /// Writes `contents` to path atomically (temp + rename).
 void write_text_atomic(const std::string& path, const std::string& contents);
+/// Copies the file `from` to `to` atomically (temp + rename), replacing `to`.
+void copy_file_atomic(const std::string& from, const std::string& to);
 
 float linear_to_srgb(float v);
 

@@ -5,6 +5,7 @@
 #include "pipeline/edit_session.h"
 #include "pipeline/emitter_refiner.h"
 #include "pipeline/fit_folder.h"
+#include "pipeline/frame_cache.h"
 #include "pipeline/paths.h"
 #include "pipeline/reference.h"
 #include "pipeline/refiner_io.h"
@@ -113,19 +114,25 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
                                     stem + "_reference.png", ref_rgb);
 }
 
-/// Renders, refines and decodes frame `i`; returns its metrics row (empty without job.reference).
-std::string render_frame(const EditJob& job, EditSession& session, const Tools& t, int i, int w, int h,
-                         const fs::path& out) {
+/// Whether frame i shows the training view: the scene as fitted, without -D overrides.
+bool shows_training_view(const EditJob& job, const EditSession& session, int i) {
+    return session.unedited(i) && job.defines.empty();
+}
+
+/// Renders, refines and decodes frame `i` into the files `stem` + suffix; returns their suffixes
+/// and the frame's scores (empty without job.reference).
+CachedFrame render_frame(const EditJob& job, EditSession& session, const Tools& t, int i, int w, int h,
+                         const std::string& stem, const std::string& name) {
     const FrameLatents f = session.frame(i, job.spp, job.seed, w, h);
     const bool refiner = session.has_refiner();
     const std::vector<float>&latent = f.latent, &refined = f.refined;
-    char name[64];
-    std::snprintf(name, sizeof name, "frame_%04d", i);
-    const std::string stem = (out / name).string();
+    CachedFrame frame;
     write_latent(stem + "_latent.exr", w, h, latent);
+    frame.suffixes.push_back("_latent.exr");
     if (refiner) {
         write_refiner_aovs(stem + "_aov.exr", f.view);
         write_latent(stem + "_refined.exr", w, h, refined);
+        frame.suffixes.insert(frame.suffixes.end(), {"_aov.exr", "_refined.exr"});
     }
     // Each latent is decoded once (~5 s at 1024² on 2 cores): the picture and the scores read it.
     std::vector<float> rgb, refined_rgb;
@@ -133,26 +140,51 @@ std::string render_frame(const EditJob& job, EditSession& session, const Tools& 
         // frame_NNNN.png is the result (refined when there is a refiner); _rendered.png the unrefined one.
         rgb = t.vae->decode(latent, w, h);
         write_png_display(stem + (refiner ? "_rendered.png" : ".png"), Image{8 * w, 8 * h, 3, rgb, {}});
+        frame.suffixes.push_back(refiner ? "_rendered.png" : ".png");
         if (refiner) {
             refined_rgb = t.vae->decode(refined, w, h);
             write_png_display(stem + ".png", Image{8 * w, 8 * h, 3, refined_rgb, {}});
+            frame.suffixes.push_back(".png");
         }
     }
-    if (!job.reference) return {};
+    if (!job.reference) return frame;
     std::vector<float> ref_rgb;
-    const std::vector<float> ref = frame_reference(job, session.fit(), t, i, name,
-                                                   session.unedited(i) && job.defines.empty(), stem, w, h, ref_rgb);
+    const std::vector<float> ref =
+        frame_reference(job, session.fit(), t, i, name, shows_training_view(job, session, i), stem, w, h, ref_rgb);
+    frame.suffixes.push_back("_reference.png");
+    frame.scores = frame_metrics(latent, std::move(rgb), ref, ref_rgb, w, h, t);
+    if (refiner) frame.scores += frame_metrics(refined, std::move(refined_rgb), ref, ref_rgb, w, h, t);
+    return frame;
+}
+
+/// Frame i's metrics row (empty without job.reference). With job.frame_cache a frame that shows
+/// the training view is rendered once for every sequence: taken from the cache when another job
+/// kept it there under `training_view_key`, else rendered and kept.
+std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, int i, int w, int h,
+                      const fs::path& out, const std::string& training_view_key) {
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%04d", i);
+    const std::string stem = (out / name).string();
+    const bool shared = !job.frame_cache.empty() && shows_training_view(job, session, i);
+    std::optional<std::string> scores;
+    if (shared) scores = take_cached_frame(job.frame_cache, training_view_key, name, stem);
+    if (!scores) {
+        const CachedFrame frame = render_frame(job, session, t, i, w, h, stem, name);
+        if (shared) keep_cached_frame(job.frame_cache, training_view_key, name, stem, frame);
+        scores = frame.scores;
+    }
+    if (!job.reference) return {};
     std::ostringstream row;
-    row << i << "," << session.time(i) << frame_metrics(latent, std::move(rgb), ref, ref_rgb, w, h, t);
-    if (refiner) row << frame_metrics(refined, std::move(refined_rgb), ref, ref_rgb, w, h, t);
+    row << i << "," << session.time(i) << *scores;
     return row.str();
 }
 
 /// What a frame's files depend on besides its index: the fit (manifest, parameters, refiner), the
 /// edit file and the render settings, as an FNV-1a hash. frame_NNNN.done starts with it, so
 /// --resume skips a frame only if the same fit and settings made it (a refitted fit, rerun by a
-/// workflow, renders its frames again).
-std::string frame_key(const EditJob& job) {
+/// workflow, renders its frames again). A frame that shows the training view does not depend on
+/// the edit file: its name in the frame cache leaves the file out (`with_edits` false).
+std::string frame_hash(const EditJob& job, bool with_edits) {
     uint64_t h = 14695981039346656037ULL;
     auto add = [&h](const std::string& text) {
         for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
@@ -164,7 +196,7 @@ std::string frame_key(const EditJob& job) {
     }
     const fs::path emitters = fs::path(job.fitdir) / kEmitterRefinerFile;
     if (fs::exists(emitters)) add(read_file(emitters.string()));  // only then: other folders keep their keys
-    add(read_file(job.edits));
+    add(with_edits ? read_file(job.edits) : std::string("the training view, in any sequence"));
     for (const auto& [key, value] : job.defines) add(key + "=" + value);
     if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before
     add(std::to_string(job.width) + "x" + std::to_string(job.height) + " spp " + std::to_string(job.spp) + " seed " +
@@ -172,9 +204,12 @@ std::string frame_key(const EditJob& job) {
         reference_seed_suffix(job.ref_seed));     // empty for the default seed: keys as before
     if (job.reference) add(kEditedFrameSeedTag);  // edited frames' references changed seeds: score them again
     char buf[40];
-    std::snprintf(buf, sizeof buf, "key %016llx", static_cast<unsigned long long>(h));
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
     return buf;
 }
+
+/// The first line of frame_NNNN.done.
+std::string frame_key(const EditJob& job) { return "key " + frame_hash(job, true); }
 
 /// The metrics row of a finished frame whose .done carries `key`; nullopt when it was made from
 /// another fit or settings (or before keys were written).
@@ -206,7 +241,7 @@ int render_edits(const EditJob& job, const Reporter& report) {
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
     if (job.frame_step < 1) throw std::invalid_argument("frame step must be at least 1");
     const int count = (last - first) / job.frame_step + 1;
-    const std::string key = frame_key(job);
+    const std::string key = frame_key(job), training_view_key = frame_hash(job, false);
     bool told = false;
     for (int i = first; i <= last; i += job.frame_step) {
         char name[64];
@@ -219,7 +254,7 @@ int render_edits(const EditJob& job, const Reporter& report) {
             told = told || !row;
         }
         if (!row) {
-            row = render_frame(job, session, tools, i, w, h, out);
+            row = frame_row(job, session, tools, i, w, h, out, training_view_key);
             write_text_atomic(done.string(), key + "\n" + *row);
         }
         if (job.reference) csv << *row << "\n";

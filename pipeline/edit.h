@@ -27,6 +27,10 @@ struct EditJob {
     /// measure their noise (docs/metrics.md "Reference noise").
     uint64_t ref_seed = kReferenceSeed;
     std::string reference_cache;  ///< keeps path-traced reference frames for reuse
+    /// Keeps the frames that show the training view (frame 0 of every sequence), rendered,
+    /// decoded and scored, for the other sequences of the same fit and settings
+    /// (pipeline/frame_cache.h); empty: every job renders its own.
+    std::string frame_cache;
     /// Only frames first_frame..last_frame (inclusive; -1 = the last): a sequence split into jobs
     /// gives the same frame files as one job, since frame i depends on i alone (seed + i). A
     /// job given a range (last_frame >= 0) writes its metrics rows to metrics_<first>-<last>.csv,

@@ -453,20 +453,23 @@ def training_reference_command(c, scene, threads):
                                 decay=False))
 
 
-def edit_argv(binary, threads, fitdir, edits, out, spp, ref_spp, refs, frames=None):
+def edit_argv(binary, threads, fitdir, edits, out, spp, ref_spp, refs, frames=None, frame_cache=None):
     """`latentpt render <fitdir> --edit --reference` of the frames "A:B:S" (all when None) against
-    references cached in `refs`, resuming a killed run. Snakemake compares its jobs' commands
+    references cached in `refs`, resuming a killed run; with `frame_cache` the frames that show the
+    training view are rendered once for all sequences. Snakemake compares its jobs' commands
     with the recorded ones: keep the order of the arguments."""
     cmd = [binary, "--threads", str(threads), "render", fitdir, "--edit", edits, "--reference", "--ref-spp",
            str(ref_spp), "--reference-cache", refs, "--spp", str(spp), "-q", "--resume", "--out", out]
-    return cmd + (["--frames", frames] if frames else [])
+    return cmd + (["--frames", frames] if frames else []) + (["--frame-cache", frame_cache] if frame_cache else [])
 
 
 def edit_command(c, scene, fit, edits, out, spp, threads, frames=None):
-    """edit_argv of one ablation fit and frames A:B (all when None), as a shell command."""
+    """edit_argv of one ablation fit and frames A:B (all when None), as a shell command; the
+    scene's sequences and convergence renders share the frames that show the training view."""
     spec = f"{frames[0]}:{frames[1]}:{c.get('frame_step', 1)}" if frames else None
     return shlex.join(edit_argv(c["bin"], threads, os.path.join(scene, "fit_" + fit), edits, out, spp,
-                                ref_spp_of(c, scene), os.path.join(scene, "refs"), spec))
+                                ref_spp_of(c, scene), os.path.join(scene, "refs"), spec,
+                                os.path.join(scene, "frames")))
 
 
 def second_reference_command(c, scene, kind, threads):

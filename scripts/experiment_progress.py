@@ -88,9 +88,11 @@ def fit_s(c, scene, name):
 
 def edit_chunk_s(c, scene, kind, name, first, last):
     """A chunk of a sequence: its frames, and in the eac fit's job their references but frame 0's
-    (the training view's, traced by the training-reference job)."""
+    (the training view's, traced by the training-reference job). Frame 0 is rendered once per fit
+    (render --frame-cache), counted in the first sequence's chunk; the others copy it."""
     frames = [f for f in X.frames_evaluated(c, scene, kind) if first <= f <= last]
-    s = start_s(scene) + len(frames) * frame_s(c, scene, name, c["spp"])
+    rendered = [f for f in frames if f != 0 or kind == X.KINDS[0]]
+    s = start_s(scene) + len(rendered) * frame_s(c, scene, name, c["spp"])
     if name == "eac":
         s += sum(reference_s(c, scene, X.ref_spp_of(c, scene)) for f in frames if f != 0)
     return s
@@ -121,7 +123,8 @@ def planned_jobs(c):
                                  edit_chunk_s(c, scene, kind, name, first, last)))
         for view in c.get("conv_views", ["training", "novel"]):
             for i, spp in enumerate(c["spp_list"]):
-                s = start_s(scene) + frame_s(c, scene, "eac", spp)
+                copied = view == "training" and spp == c["spp"]  # the edit sequences' frame 0
+                s = start_s(scene) + (0.0 if copied else frame_s(c, scene, "eac", spp))
                 if view != "training" and i == 0:  # the first spp's job traces the view's reference
                     s += reference_s(c, scene, X.ref_spp_of(c, scene))
                 jobs.append((os.path.join(b, f"conv_{view}_{spp}.tsv"), s))

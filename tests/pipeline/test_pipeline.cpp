@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <map>
 
 using namespace lpt;
 namespace fs = std::filesystem;
@@ -175,6 +176,67 @@ TEST(Pipeline, ResumedEditsRenderAgainWhenTheFitChanged) {
     pipeline::render_edits(edit, r);
     EXPECT_TRUE(notes.empty());
     EXPECT_FALSE(fs::exists(edit.out + "/frame_0001_latent.exr")) << "a finished frame was rendered again";
+}
+
+/// Every file of `dir` by name, with its bytes.
+std::map<std::string, std::string> files_of(const std::string& dir) {
+    std::map<std::string, std::string> files;
+    for (const auto& e : fs::directory_iterator(dir))
+        files[e.path().filename().string()] = read_file(e.path().string());
+    return files;
+}
+
+// Frame 0 of every sequence shows the training view: with a frame cache the second sequence takes
+// its files from the first one's job, byte for byte what rendering it would give; edited frames
+// and other settings are never taken from the cache.
+TEST(Pipeline, FramesThatShowTheTrainingViewAreRenderedOnceForEverySequence) {
+    const std::string dir = test::temp_dir("pipeline-frame-cache");
+    pipeline::EditJob first = demo_edit_of_a_small_fit(dir);
+    first.last_frame = 1;
+    first.reference = true;  // and its scores: metrics_0-1.csv
+    first.ref_spp = 4;
+    first.frame_cache = dir + "/cache";
+    pipeline::render_edits(first);
+    // Another sequence: the demo's edits, half as far.
+    std::string half = read_file(first.edits);
+    half.replace(half.find("[0, 24]"), 7, "[0, 12]");
+    pipeline::EditJob second = first;
+    second.edits = dir + "/edits-half.json";
+    write_text_atomic(second.edits, half);
+    second.out = dir + "/second";
+    pipeline::render_edits(second);
+    pipeline::EditJob uncached = second;
+    uncached.out = dir + "/uncached";
+    uncached.frame_cache.clear();
+    pipeline::render_edits(uncached);
+    const std::map<std::string, std::string> got = files_of(second.out), want = files_of(uncached.out);
+    EXPECT_TRUE(want.count("metrics_0-1.csv") && want.count("frame_0000_reference.png"));
+    for (const auto& [name, bytes] : want) EXPECT_TRUE(got.count(name) && got.at(name) == bytes) << name;
+    EXPECT_NE(got.at("frame_0001_latent.exr"), files_of(first.out).at("frame_0001_latent.exr"));
+    int entries = 0;
+    std::string cached_latent;
+    for (const auto& e : fs::directory_iterator(first.frame_cache)) {
+        entries += e.path().extension() == ".frame";
+        const std::string file = e.path().filename().string();
+        if (file.find("_frame_0000.") != std::string::npos && file.size() > 11 &&
+            file.compare(file.size() - 11, 11, "_latent.exr") == 0)
+            cached_latent = e.path().string();
+    }
+    EXPECT_EQ(entries, 1) << "frame 1 is edited: only frame 0 is kept";
+    ASSERT_FALSE(cached_latent.empty());
+    // The second sequence's frame 0 comes from the cache: a changed entry shows in its output.
+    fs::copy_file(first.out + "/frame_0001_latent.exr", cached_latent, fs::copy_options::overwrite_existing);
+    second.out = dir + "/from-cache";
+    pipeline::render_edits(second);
+    EXPECT_EQ(read_file(second.out + "/frame_0000_latent.exr"), read_file(cached_latent));
+    // Other settings (spp) render their own frame 0 and keep it beside.
+    second.spp = 3;
+    second.out = dir + "/spp3";
+    pipeline::render_edits(second);
+    EXPECT_NE(read_file(second.out + "/frame_0000_latent.exr"), read_file(cached_latent));
+    entries = 0;
+    for (const auto& e : fs::directory_iterator(first.frame_cache)) entries += e.path().extension() == ".frame";
+    EXPECT_EQ(entries, 2);
 }
 
 // The in-memory session computes exactly what render --edit writes, frame for frame.
