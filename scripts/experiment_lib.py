@@ -11,10 +11,11 @@ import os
 import shlex
 import subprocess
 import sys
+import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from paper_table import (NOISE_MEASURES, PAPER_NAMES, PAPER_TABLE1, TABLE1_COLUMNS,  # noqa: E402,F401 (re-exported)
-                         independent_table1_summary, noise_table1_entry, table1, table1_html, table1_rows)
+                         TABLE1_NOTE, TABLE1_TARGETS, independent_table1_summary, noise_table1_entry, table1, table1_html, table1_rows)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -58,8 +59,9 @@ def mean(rows, key):
 
 
 def svg_plot(title, series, ylabel, xlabel="frame", xticks=None, width=480, height=260):
-    """A minimal line chart: series = [(label, colour, [y per x position])]. The x axis is the
-    frame index, or the labels `xticks` (one per position, e.g. spp) under `xlabel`."""
+    """A minimal line chart: series = [(label, colour, [y per x position])], each value marked by
+    a dot. The x axis is the frame index, or the labels `xticks` (one per position, e.g. spp)
+    under `xlabel`; at most 12 of them are written."""
     pad_l, pad_r, pad_t, pad_b = 56, 110, 28, 36
     ys = [y for _, _, v in series for y in v if y == y]
     if not ys:
@@ -74,8 +76,11 @@ def svg_plot(title, series, ylabel, xlabel="frame", xticks=None, width=480, heig
            f'<line x1="{pad_l}" y1="{pad_t}" x2="{pad_l}" y2="{height - pad_b}" stroke="black"/>',
            f'<text x="{(pad_l + width - pad_r) / 2}" y="{height - 6}" text-anchor="middle">{html.escape(xlabel)}</text>',
            f'<text x="14" y="{height / 2}" transform="rotate(-90 14 {height / 2})" text-anchor="middle">{html.escape(ylabel)}</text>']
-    ticks = xticks or [str(i) for i in range(n)] if n <= 12 else None
-    for i, t in enumerate(ticks or []):
+    ticks = list(xticks) if xticks else [str(i) for i in range(n)]
+    every = -(-len(ticks) // 12)  # ceil: a 60-frame sequence gets every 5th
+    for i, t in enumerate(ticks):
+        if i % every:
+            continue
         out.append(f'<text x="{sx(i):.1f}" y="{height - pad_b + 13}" text-anchor="middle">{html.escape(str(t))}</text>')
     for k in range(5):
         y = lo + (hi - lo) * k / 4
@@ -83,17 +88,38 @@ def svg_plot(title, series, ylabel, xlabel="frame", xticks=None, width=480, heig
     for j, (label, colour, v) in enumerate(series):
         pts = " ".join(f"{sx(i):.1f},{sy(y):.1f}" for i, y in enumerate(v) if y == y)
         out.append(f'<polyline fill="none" stroke="{colour}" stroke-width="1.6" points="{pts}"/>')
+        out += [f'<circle cx="{sx(i):.1f}" cy="{sy(y):.1f}" r="2.5" fill="{colour}"/>' for i, y in enumerate(v) if y == y]
         out.append(f'<text x="{width - pad_r + 8}" y="{pad_t + 14 * j + 10}" fill="{colour}">{html.escape(label)}</text>')
     out.append("</svg>")
     return "\n".join(out)
 
 
-def img_tag(path, width=160):
+def thumbnail(path, width):
+    """(MIME type, bytes) of the image at `path` shrunk to `width` pixels, by oiiotool (a 1024²
+    frame is ~1.5 MB as PNG, its 320-pixel JPEG ~15 kB, the same bytes every run); the file itself
+    where oiiotool fails."""
+    with tempfile.TemporaryDirectory() as d:
+        small = os.path.join(d, "thumbnail.jpg")
+        try:
+            r = subprocess.run(["oiiotool", "--nosoftwareattrib", path, "--resize:filter=box", f"{width}x0",
+                                "--compression", "jpeg:90", "-o", small], capture_output=True)
+            if r.returncode == 0:
+                with open(small, "rb") as f:
+                    return "image/jpeg", f.read()
+        except OSError:
+            pass
+    with open(path, "rb") as f:
+        return "image/png", f.read()
+
+
+def img_tag(path, link, width=160):
+    """A table cell with the image at `path` embedded at `width` pixels (twice that stored, for
+    high-density screens), linking to the full image at `link` (relative to the report)."""
     if not os.path.exists(path):
         return "<td>(missing)</td>"
-    with open(path, "rb") as f:
-        data = base64.b64encode(f.read()).decode()
-    return f'<td><img width="{width}" src="data:image/png;base64,{data}"/></td>'
+    mime, data = thumbnail(path, 2 * width)
+    return (f'<td><a href="{html.escape(link)}"><img width="{width}" '
+            f'src="data:{mime};base64,{base64.b64encode(data).decode()}"/></a></td>')
 
 
 def write_atomic(path, text):
@@ -115,41 +141,50 @@ def run_logged(cmd, log, who):
         sys.exit(f"{who}: command failed (exit {r.returncode}), see {log}: {' '.join(cmd)}")
 
 
+def settings_line(c):
+    """The run's settings in one sentence (summary.md, report.html)."""
+    image_res, fit_its, ref_its, frames = c["image_res"], c["fit_iterations"], c["refiner_iterations"], c["frames"]
+    step = c.get("frame_step", 1)
+    dropout = f", dropout {c['refiner_dropout']:g}" if c.get("refiner_dropout") is not None else ""
+    dropout += ", emitter refiner" if c.get("refiner_emitters") else ""
+    return (f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
+            "reference spp per scene below, "
+            f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}"
+            f"{', latent target ' + c['refiner_latent_target'] if c.get('refiner_latent_target', 'encoded') != 'encoded' else ''}"
+            f"{dropout}), "
+            f"parameterisation {c.get('param', 'code')}, emission decay {c.get('emission_decay', 0):g}, "
+            f"emitter response decay {c.get('emitter_response_decay', 0):g}, frames {frames or 'as in the edit files'}"
+            f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp")
+
+
 def write_outputs(out, c, summary, failures, timings, noise=None):
     """summary.md/json, the SVG plots and report.html under `out`. summary.json holds results
     only (no timings: a cluster run and a local run of one config give the same file);
     timings.json holds the job times. noise: reference_noise.py's result per scene
     (--second-references), for Table 1 against the independent references."""
-    image_res, fit_its, ref_its, frames = c["image_res"], c["fit_iterations"], c["refiner_iterations"], c["frames"]
     # Tables (markdown) and plots.
     colours = {"e": "#999999", "ea": "#1f77b4", "eac": "#2ca02c", "eac+refiner": "#d62728", "baseline": "#9467bd",
                "baseline+refiner": "#e377c2"}
     configs, step = configs_of(c), c.get("frame_step", 1)
-    dropout = f", dropout {c['refiner_dropout']:g}" if c.get("refiner_dropout") is not None else ""
-    dropout += ", emitter refiner" if c.get("refiner_emitters") else ""
-    md = ["# latentpt experiment summary", "",
-          f"settings: image {'per scene (below)' if c.get('scene_res') else f'{image_res}² (latents {image_res // 8}²)'}, "
-          "reference spp per scene below, "
-          f"stage 1 {fit_its} iterations, refiner {ref_its} iterations (lr decay {c.get('refiner_lr_decay', 'none')}"
-          f"{', latent target ' + c['refiner_latent_target'] if c.get('refiner_latent_target', 'encoded') != 'encoded' else ''}"
-          f"{dropout}), "
-          f"parameterisation {c.get('param', 'code')}, emission decay {c.get('emission_decay', 0):g}, "
-          f"emitter response decay {c.get('emitter_response_decay', 0):g}, frames {frames or 'as in the edit files'}"
-          f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp", ""]
+    md = ["# latentpt experiment summary", "", settings_line(c), ""]
+    facts = {}  # per scene: the sentences and the equal-error table report.html repeats
     for scene, s in summary.items():
         t = s["training_view"]
         res = image_res_of(c, scene)
-        md += [f"## {scene}", "", f"Image {res}² (latents {res // 8}²). References: training view {training_ref_spp_of(c, scene)} spp, "
-               f"edited frames {s.get('ref_spp')} spp.", "", "Training view (decoded vs reference): " +
-               ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
-                         for k in ("rendered", "refined", "vae_roundtrip") if k in t), "",
+        facts[scene] = {"lines": [
+            f"Image {res}² (latents {res // 8}²). References: training view {training_ref_spp_of(c, scene)} spp, "
+            f"edited frames {s.get('ref_spp')} spp.", "Training view (decoded vs reference): " +
+            ", ".join(f"{k} LPIPS {t[k].get('rgb_lpips', float('nan')):.4f} / MSE×100 {t[k].get('rgb_mse_x100', float('nan')):.4f}"
+                      for k in ("rendered", "refined", "vae_roundtrip") if k in t)]}
+        md += [f"## {scene}", "", facts[scene]["lines"][0], "", facts[scene]["lines"][1], "",
                "| edit | config | LPIPS | MSE×100 | latent D-SSIM |", "|---|---|---|---|---|"]
         for kind, table in s["edits"].items():
             for key, label in configs:
                 r = table[key]
                 md.append(f"| {kind} | {label} | {r['rgb_lpips']:.4f} | {r['rgb_mse_x100']:.4f} | {r['latent_dssim']:.4f} |")
             for metric, ylabel in (("lpips", "LPIPS (decoded)"), ("dssim", "D-SSIM (latent)")):
-                svg = svg_plot(f"{scene}, {kind} edit", [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in configs],
+                svg = svg_plot(f"{scene}, {kind} edit: {ylabel}",
+                               [(label, colours[key], table[key]["per_frame_" + metric]) for key, label in configs],
                                ylabel, xlabel="frame of the edit sequence", xticks=sequence_frames(table) if step > 1 else None)
                 write_atomic(os.path.join(out, f"{scene}_{kind}_{metric}.svg"), svg)
         if s.get("convergence"):  # conv_views=[] runs none
@@ -162,25 +197,26 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
                                [(lab, col, [r[k] for r in by_spp.values()]) for k, lab, col in
                                 (("latent_dssim", "D-SSIM", "#1f77b4"), ("refined_latent_dssim", "D-SSIM refined", "#2ca02c"),
                                  ("rgb_lpips", "LPIPS", "#ff7f0e"), ("refined_rgb_lpips", "LPIPS refined", "#d62728"))],
-                               "error", xlabel="latent samples per pixel", xticks=list(by_spp))
+                               "D-SSIM (latent), LPIPS (decoded)", xlabel="latent samples per pixel (one position each)",
+                               xticks=list(by_spp))
                 write_atomic(os.path.join(out, f"{scene}_convergence_{view}.svg"), svg)
         t = timings.get(scene, {})
         if t.get("stages"):
-            md += ["", f"Job time for {scene} (sum over its jobs, from Snakemake's benchmarks; jobs that ran in "
-                   "parallel overlap, finished jobs reused from an earlier run count once): " +
-                   ", ".join(f"{k} {v / 60:.1f} min" for k, v in t["stages"].items())]
+            facts[scene]["lines"].append(
+                f"Job time for {scene} (sum over its jobs, from Snakemake's benchmarks; jobs that ran in "
+                "parallel overlap, finished jobs reused from an earlier run count once): " +
+                ", ".join(f"{k} {v / 60:.1f} min" for k, v in t["stages"].items()))
+            md += ["", facts[scene]["lines"][-1]]
         if t.get("equal_error"):
+            facts[scene]["equal_error"] = t["equal_error"].rstrip()
             md += ["", "Equal-error runtime (`latentpt bench --equal-error`, this machine, timings from one process):", "", "```",
-                   t["equal_error"].rstrip(), "```"]
+                   facts[scene]["equal_error"], "```"]
         md.append("")
     has_table1 = all(sc in PAPER_TABLE1 and set(s["edits"]) == set(KINDS) and "eac" in fits_of(c) for sc, s in summary.items())
     if has_table1:
         t1, misses = table1(c, summary)
-        md += ["## Table 1 layout: ours (paper's), LPIPS / MSE×100", "",
-               "Mean over the evaluated frames; the paper's values (in brackets) are SD3.5's VAE and AlexNet LPIPS "
-               "over all 60 frames at 1024²; ours are TAESD3 and SqueezeNet LPIPS. VAE round trip: the training "
-               "view's reference encoded and decoded by TAESD3, the floor no latent can beat.", ""] + t1
-        md += ["", "Targets (issue 16): " + ("all met." if not misses else f"{len(misses)} missed:"), ""]
+        md += ["## Table 1 layout: ours (paper's), LPIPS / MSE×100", "", TABLE1_NOTE, ""] + t1
+        md += ["", f"Targets (issue 16): {TABLE1_TARGETS} " + ("All met." if not misses else f"{len(misses)} missed:"), ""]
         md += [f"- {x}" for x in misses]
         md.append("")
     if noise:
@@ -194,12 +230,19 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
     write_atomic(os.path.join(out, "summary.json"), json.dumps(results, indent=1))
     write_atomic(os.path.join(out, "timings.json"), json.dumps(timings, indent=1))
 
-    # Self-contained HTML report.
+    write_report(out, c, summary, failures, facts, has_table1, noise)
+    return md
+
+
+def write_report(out, c, summary, failures, facts, has_table1, noise):
+    """report.html: write_outputs' tables, the plots and each sequence's frames, self-contained
+    (small images embedded, each linking to its full-size file beside the report)."""
+    configs = configs_of(c)
     h = ["<!doctype html><html><head><meta charset='utf-8'><title>latentpt experiments</title>",
          "<style>body{font-family:sans-serif;margin:2em;max-width:1200px} table{border-collapse:collapse} "
-         "td,th{border:1px solid #ccc;padding:3px 8px} img{image-rendering:pixelated} .miss{color:#c00;font-weight:bold} "
-         ".paper{color:#888;font-size:90%} .t1 td{white-space:nowrap}</style></head><body>",
-         "<h1>latentpt experiments</h1>", f"<p>{html.escape(md[2])}</p>"]
+         "td,th{border:1px solid #ccc;padding:3px 8px} .miss{color:#c00;font-weight:bold} "
+         ".paper{color:#888;font-size:90%} .t1 td{white-space:nowrap} pre{font-size:85%}</style></head><body>",
+         "<h1>latentpt experiments</h1>", f"<p>{html.escape(settings_line(c))}</p>"]
     if has_table1:
         h += table1_html(c, summary, "Table 1 layout (against the experiment's references)")
     independent = independent_table1_summary(noise) if noise else None
@@ -207,7 +250,8 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
         h += table1_html(c, independent, "Table 1 against an independent reference per frame "
                          "(--second-references; MSE×100 less the reference's noise)")
     for scene, s in summary.items():
-        h.append(f"<h2>{html.escape(scene)}</h2><table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
+        h.append(f"<h2>{html.escape(scene)}</h2>" + "".join(f"<p>{html.escape(x)}</p>" for x in facts[scene]["lines"]))
+        h.append("<table><tr><th>edit</th><th>config</th><th>LPIPS</th><th>MSE×100</th><th>latent D-SSIM</th></tr>")
         for kind, table in s["edits"].items():
             for key, label in configs:
                 r = table[key]
@@ -216,24 +260,27 @@ def write_outputs(out, c, summary, failures, timings, noise=None):
         h.append("</table>")
         for view in s.get("convergence", {}):
             with open(os.path.join(out, f"{scene}_convergence_{view}.svg")) as f:
-                h.append(f.read())
+                h += [f"<h3>Convergence of the eac fit, {view} view</h3><div>", f.read(), "</div>"]
+        if facts[scene].get("equal_error"):
+            h += ["<h3>Equal-error runtime (<code>latentpt bench --equal-error</code>, this machine)</h3>",
+                  f"<pre>{html.escape(facts[scene]['equal_error'])}</pre>"]
         for kind in s["edits"]:
+            h.append(f"<h3>{kind} edit</h3><div>")
             for metric in ("lpips", "dssim"):
                 with open(os.path.join(out, f"{scene}_{kind}_{metric}.svg")) as f:
                     h.append(f.read())
             columns = strip_columns(fits_of(c))
-            h.append(f"<h3>{kind}: {' / '.join(label for label, _, _ in columns)}</h3><table>")
+            h.append("</div><table><tr><th></th>" + "".join(f"<th>{html.escape(label)}</th>" for label, _, _ in columns) + "</tr>")
             frames = sequence_frames(s["edits"][kind])
             for i in sorted({frames[0], frames[len(frames) // 2], frames[-1]}):
-                d = os.path.join(out, scene)
-                h.append("<tr><td>frame %d</td>" % i + "".join(img_tag(os.path.join(d, f"{kind}_{fit}", png.format(i=i)))
-                                                               for _, fit, png in columns) + "</tr>")
+                cells = "".join(img_tag(os.path.join(out, scene, f"{kind}_{fit}", png.format(i=i)),
+                                        f"{scene}/{kind}_{fit}/{png.format(i=i)}") for _, fit, png in columns)
+                h.append(f"<tr><td>frame {i}</td>{cells}</tr>")
             h.append("</table>")
     if failures:
         h.append("<h2>Ordering check failed</h2><ul>" + "".join(f"<li>{html.escape(x)}</li>" for x in failures) + "</ul>")
     h.append("</body></html>")
     write_atomic(os.path.join(out, "report.html"), "\n".join(h))
-    return md
 
 
 

@@ -5,6 +5,8 @@ their overrides, the Table 1 target check failing where it must, and --second-re
 and table."""
 import json
 import os
+import shutil
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -26,6 +28,30 @@ class Chunks(unittest.TestCase):
     def test_edit_command_passes_the_step(self):
         c = X.settings(frames=60, frame_step=6)
         self.assertIn("--frames 48:54:6", X.edit_command(c, "cbox-specular", "eac", "e.json", "o", 64, 2, (48, 54)))
+
+
+class Report(unittest.TestCase):
+    def test_every_plot_labels_its_x_axis(self):
+        # 60 frames (no labels at all before) and explicit labels past 12 (dropped before)
+        for n, xticks in ((60, None), (20, [f"f{i}" for i in range(20)]), (5, ["1", "4", "16", "64", "256"])):
+            svg = X.svg_plot("t", [("a", "#000", [float(i) for i in range(n)])], "y", xticks=xticks)
+            labels = xticks or [str(i) for i in range(n)]
+            written = [t for t in labels if f'text-anchor="middle">{t}</text>' in svg]  # not the y axis's
+            self.assertIn(labels[0], written, n)
+            self.assertTrue(len(written) >= min(n, 5) and len(written) <= 12, (n, written))
+            self.assertEqual(svg.count("<circle"), n, "one dot per value")
+
+    @unittest.skipUnless(shutil.which("oiiotool"), "oiiotool not installed")
+    def test_frames_are_embedded_small_and_link_to_the_full_image(self):
+        with tempfile.TemporaryDirectory() as d:
+            png = os.path.join(d, "frame.png")
+            subprocess.run(["oiiotool", "--pattern", "noise:type=uniform", "1024x1024", "3", "-d", "uint8", "-o", png],
+                           check=True)
+            cell = X.img_tag(png, "scene/camera_eac/frame.png")
+            self.assertIn('<a href="scene/camera_eac/frame.png">', cell)
+            self.assertIn('src="data:image/jpeg;base64,', cell)
+            self.assertLess(len(cell), os.path.getsize(png) / 4)
+            self.assertEqual(cell, X.img_tag(png, "scene/camera_eac/frame.png"), "the same bytes every run")
 
 
 class Preset(unittest.TestCase):
@@ -252,7 +278,8 @@ class NarrowedFits(unittest.TestCase):
         self.assertEqual(table["eac"]["frames"], self.FRAMES)
         self.assertAlmostEqual(table["eac"]["rgb_lpips"], 0.2 + 0.001 * sum(self.FRAMES) / 4)
         self.assertIn("| light | +refiner | 0.1000 |", md)
-        self.assertIn("<h3>light: reference / +Ĩa+Ĩc / +refiner</h3>", report)
+        self.assertIn("<h3>light edit</h3>", report)
+        self.assertIn("<tr><th></th><th>reference</th><th>+Ĩa+Ĩc</th><th>+refiner</th></tr>", report)
         self.assertNotIn("Convergence", md)  # conv_views=[]: no empty table
         # first, middle and last of the scored frames
         self.assertEqual([f for f in self.FRAMES if f"<td>frame {f}</td>" in report], [0, 30, 45])
@@ -261,7 +288,7 @@ class NarrowedFits(unittest.TestCase):
         _, report, _, failures = self.run_summary(["e", "eac"], {"e": 0.2, "eac": 0.3})
         self.assertEqual(len(failures), 3, failures)
         self.assertTrue(all("eac LPIPS" in x and "worse than e alone" in x for x in failures), failures)
-        self.assertIn("<h3>camera: reference / Ĩe / +Ĩa+Ĩc / +refiner</h3>", report)
+        self.assertIn("<tr><th></th><th>reference</th><th>Ĩe</th><th>+Ĩa+Ĩc</th><th>+refiner</th></tr>", report)
 
 
 if __name__ == "__main__":
