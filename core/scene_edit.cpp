@@ -162,19 +162,31 @@ EditSequence load_edits(const std::string& path, const Scene& scene) {
     return seq;
 }
 
+namespace {
+
+bool moves(const ShapeEdit& e, float t) {
+    return e.translate.at(t) != Vec3f::Zero() || e.scale.at(t) != Vec3f::Ones() || e.rotate_angle.at(t).x() != 0.f;
+}
+
+bool orbits(const CameraEdit& c, float t) {
+    return c.kind == CameraEdit::Kind::Orbit && (c.azimuth.at(t).x() != 0.f || c.elevation.at(t).x() != 0.f);
+}
+
+}  // namespace
+
 bool is_unedited(const EditSequence& edits, float t) {
     for (const ShapeEdit& e : edits.shapes)
-        if (e.translate.at(t) != Vec3f::Zero() || e.scale.at(t) != Vec3f::Ones() || e.rotate_angle.at(t).x() != 0.f)
-            return false;
-    const CameraEdit& c = edits.camera;
-    if (c.kind == CameraEdit::Kind::LookAt) return false;
-    return c.kind == CameraEdit::Kind::None || (c.azimuth.at(t).x() == 0.f && c.elevation.at(t).x() == 0.f);
+        if (moves(e, t)) return false;
+    return edits.camera.kind != CameraEdit::Kind::LookAt && !orbits(edits.camera, t);
 }
 
 void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleMesh>& original,
                  const Camera& original_camera, Scene& scene) {
     for (size_t i = 0; i < scene.shapes.size(); ++i) scene.shapes[i].mesh = original[i];
     for (const ShapeEdit& e : edits.shapes) {
+        // An edit at rest leaves the mesh as loaded: p + (v − p) is not always v in floats, and an
+        // unedited frame must be the training view bit for bit (its reference is the training one).
+        if (!moves(e, t)) continue;
         TriangleMesh& m = scene.shapes[e.shape].mesh;
         Vec3f pivot = e.has_pivot ? e.pivot.at(t) : bounds(original[e.shape]).center();
         Transform xf = Transform::translate(e.translate.at(t)) * Transform::translate(pivot) *
@@ -184,7 +196,7 @@ void apply_edits(const EditSequence& edits, float t, const std::vector<TriangleM
     }
     scene.camera = original_camera;
     const CameraEdit& c = edits.camera;
-    if (c.kind == CameraEdit::Kind::Orbit) {
+    if (orbits(c, t)) {
         const Transform& w = original_camera.world_from_camera;
         Vec3f right = w.vector(Vec3f::UnitX()).normalized();  // camera +x (image left): elevation axis
         Transform r = Transform::rotate(c.up, c.azimuth.at(t).x()) * Transform::rotate(right, c.elevation.at(t).x());
