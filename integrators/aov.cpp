@@ -68,4 +68,23 @@ std::vector<float> render_emitter_cells(const Scene& scene, int width, int heigh
     return out;
 }
 
+std::vector<float> render_shape_coverage(const Scene& scene, int width, int height, const std::vector<int>& shapes,
+                                         int rays_per_side) {
+    Camera camera = scene.camera.with_resolution(width, height);
+    const int k = int(shapes.size()), n = rays_per_side;
+    std::vector<float> out(size_t(width) * height * k, 0.f);
+    tbb::parallel_for(0, height, [&](int y) {
+        set_ftz_daz();
+        for (int x = 0; x < width; ++x)
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) {
+                    const SurfaceInteraction si =
+                        scene.intersect(camera.generate_ray(Vec2f(x + (i + 0.5f) / n, y + (j + 0.5f) / n)));
+                    for (int s = 0; s < k; ++s)
+                        if (si.shape == shapes[s]) out[(size_t(y) * width + x) * k + s] += 1.f / float(n * n);
+                }
+    });
+    return out;
+}
+
 }  // namespace lpt

@@ -26,4 +26,10 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
 /// (docs/refiner.md "Emitter cells"). width × height × cells² values, sub-cells row-major.
 std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side = 4);
 
+/// The fraction of each pixel whose camera ray first hits each shape of `shapes`, from a regular
+/// grid of rays_per_side² rays per pixel (geometry, deterministic): width × height × shapes.size()
+/// values, the shapes' in their order per pixel.
+std::vector<float> render_shape_coverage(const Scene& scene, int width, int height, const std::vector<int>& shapes,
+                                         int rays_per_side = 8);
+
 }  // namespace lpt

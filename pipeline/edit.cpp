@@ -184,7 +184,7 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
 /// --resume skips a frame only if the same fit and settings made it (a refitted fit, rerun by a
 /// workflow, renders its frames again). A frame that shows the training view does not depend on
 /// the edit file: its name in the frame cache leaves the file out (`with_edits` false).
-std::string frame_hash(const EditJob& job, bool with_edits) {
+std::string frame_hash(const EditJob& job, const EditSession& session, bool with_edits) {
     uint64_t h = 14695981039346656037ULL;
     auto add = [&h](const std::string& text) {
         for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
@@ -203,13 +203,16 @@ std::string frame_hash(const EditJob& job, bool with_edits) {
         std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp) +
         reference_seed_suffix(job.ref_seed));     // empty for the default seed: keys as before
     if (job.reference) add(kEditedFrameSeedTag);  // edited frames' references changed seeds: score them again
+    if (!session.unseen_emitters().empty()) add("unseen emitters painted");  // their frames changed (session 41)
     char buf[40];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
     return buf;
 }
 
 /// The first line of frame_NNNN.done.
-std::string frame_key(const EditJob& job) { return "key " + frame_hash(job, true); }
+std::string frame_key(const EditJob& job, const EditSession& session) {
+    return "key " + frame_hash(job, session, true);
+}
 
 /// The metrics row of a finished frame whose .done carries `key`; nullopt when it was made from
 /// another fit or settings (or before keys were written).
@@ -229,6 +232,9 @@ int render_edits(const EditJob& job, const Reporter& report) {
     const int w = job.width > 0 ? job.width : session.latent_width();
     const int h = job.height > 0 ? job.height : session.latent_height();
     const Tools tools = open_tools(job, session, report);
+    for (int shape : session.unseen_emitters().shapes())
+        report.say("note: the training view does not show emitter '" + session.fit().scene->shapes[shape].id +
+                   "': frames show it in its display colour (docs/edits.md)");
     const fs::path out(job.out);
     fs::create_directories(out);
     std::ostringstream csv;
@@ -241,7 +247,7 @@ int render_edits(const EditJob& job, const Reporter& report) {
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
     if (job.frame_step < 1) throw std::invalid_argument("frame step must be at least 1");
     const int count = (last - first) / job.frame_step + 1;
-    const std::string key = frame_key(job), training_view_key = frame_hash(job, false);
+    const std::string key = frame_key(job, session), training_view_key = frame_hash(job, session, false);
     bool told = false;
     for (int i = first; i <= last; i += job.frame_step) {
         char name[64];

@@ -5,6 +5,7 @@
 #include "core/mesh.h"
 #include "core/scene_edit.h"
 #include "pipeline/fit_folder.h"
+#include "pipeline/unseen_emitters.h"
 #include "refiner/refiner.h"
 #include <map>
 #include <memory>
@@ -42,6 +43,9 @@ public:
     bool unedited(int i) const { return is_unedited(m_edits, time(i)); }
     /// The fit, its scene as the last frame() left it (for path-traced references of that frame).
     const FitFolder& fit() const { return m_fit; }
+    /// Emitters the training view does not show, whose look frames take from the VAE
+    /// (pipeline/unseen_emitters.h); none in most scenes.
+    const UnseenEmitters& unseen_emitters() const { return m_unseen; }
 
 private:
     FitFolder m_fit;
@@ -49,6 +53,7 @@ private:
     std::unique_ptr<Refiner> m_refiner;
     std::unique_ptr<Refiner> m_emitter_refiner;  ///< refiner_emitters.pt, when the fit folder has one
     std::vector<float> m_training_coverage;      ///< with it: emitter_coverage of the unedited view
+    UnseenEmitters m_unseen;
     std::vector<TriangleMesh> m_original;
     Camera m_camera;
 };

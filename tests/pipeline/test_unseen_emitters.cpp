@@ -1,0 +1,109 @@
+// Emitters the training view does not show (pipeline/unseen_emitters.h): a second light hidden
+// behind the box's back wall and moved into view by an edit. Its coverage is the emitter cells'
+// geometry, the frame's latent takes the flat colour's latent exactly where it covers whole
+// pixels and keeps the render wherever it is not seen, and that latent decodes to the light's
+// display colour; the box's own light, which training sees, is never painted.
+#include "core/image_io.h"
+#include "core/scene_loader.h"
+#include "integrators/aov.h"
+#include "pipeline/edit_session.h"
+#include "pipeline/fit.h"
+#include "pipeline/unseen_emitters.h"
+#include "pipeline/vae_source.h"
+#include "test_util.h"
+#include "vae/vae.h"
+#include <gtest/gtest.h>
+#include <cmath>
+
+using namespace lpt;
+
+namespace {
+
+const std::string kBox = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json";
+
+/// The box with a second light, a quad facing the camera 0.9 units behind the back wall (hidden).
+std::string box_with_a_hidden_light(const std::string& dir) {
+    std::string text = read_file(kBox);
+    const std::string light = R"({ "id": "light", "type": "mesh", "material": "light", "to_world": { "scale": 0.01 },)";
+    const size_t at = text.find(light);
+    if (at == std::string::npos) throw std::runtime_error("the box's light entry moved: update this test");
+    const std::string hidden =
+        R"({ "id": "hidden_light", "type": "mesh", "material": "light", "to_world": { "scale": 0.01 },
+      "positions": [[400, 350, 650], [150, 350, 650], [150, 520, 650], [400, 520, 650]], "indices": [[0, 1, 2, 3]],
+      "emitter": { "type": "area", "radiance": [17, 12, 4] } },
+    )";
+    text.insert(at, hidden);
+    const std::string path = dir + "/scene.json";
+    write_text_atomic(path, text);
+    return path;
+}
+
+int shape_index(const Scene& scene, const std::string& id) {
+    for (size_t i = 0; i < scene.shapes.size(); ++i)
+        if (scene.shapes[i].id == id) return int(i);
+    return -1;
+}
+
+}  // namespace
+
+TEST(UnseenEmitters, ShapeCoverageIsTheEmitterCellsOfTheOnlyEmitter) {
+    const Scene scene = load_scene(kBox);
+    const int light = shape_index(scene, "light");
+    ASSERT_GE(light, 0);
+    const std::vector<float> mine = render_shape_coverage(scene, 16, 12, {light}, 4);
+    EXPECT_EQ(mine, render_emitter_cells(scene, 16, 12, 1, 4));
+    float covered = 0.f;
+    for (float c : mine) covered += c;
+    EXPECT_GT(covered, 1.f) << "the light is in view";
+}
+
+TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
+    if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
+    const std::string dir = test::temp_dir("unseen-emitters");
+    pipeline::FitJob job;
+    job.scene = box_with_a_hidden_light(dir);
+    job.defines = {{"integrator.max_depth", "3"}};
+    job.out = dir + "/fit";
+    job.synthetic_res = "16x16";
+    job.options.iterations = 5;
+    job.options.spp = 2;
+    job.final_spp = 2;
+    job.refiner = false;
+    pipeline::run_fit(job);
+    const std::string edits = test::write_temp_file(
+        "lower.json",
+        R"({ "frames": 2, "shapes": [ { "id": "hidden_light", "translate": [[0, 0, 0], [0, 0, -3]] } ] })");
+    pipeline::EditSession session(job.out, edits);
+    const pipeline::UnseenEmitters& unseen = session.unseen_emitters();
+    const int hidden = shape_index(*session.fit().scene, "hidden_light");
+    ASSERT_EQ(unseen.shapes(), std::vector<int>{hidden}) << "the box's own light is seen in training";
+
+    const pipeline::FrameLatents f = session.frame(1, 2, 0);  // moved by 1.5: in front of the back wall
+    const std::vector<float> cover = unseen.coverage(*session.fit().scene, 16, 16);
+    const std::vector<float> raw = pipeline::render_fit_latent(session.fit(), 16, 16, 2, 1);  // seed + frame
+    const std::unique_ptr<Vae> vae = pipeline::open_vae(session.fit().vae);
+    const float white[3] = {1.f, 1.f, 1.f};  // radiance (17, 12, 4) clipped
+    const std::vector<float> look = pipeline::flat_colour_latent(*vae, white);
+    int whole = 0, unseen_pixels = 0;
+    for (size_t p = 0; p < cover.size(); ++p)
+        for (int k = 0; k < 16; ++k) {
+            const float got = f.latent[p * 16 + k];
+            if (cover[p] == 1.f) {
+                EXPECT_EQ(got, look[k]) << p;
+            } else if (cover[p] == 0.f) {
+                EXPECT_EQ(got, raw[p * 16 + k]) << p;
+            } else {
+                EXPECT_NEAR(got, (1.f - cover[p]) * raw[p * 16 + k] + cover[p] * look[k], 1e-5f) << p;
+            }
+            whole += k == 0 && cover[p] == 1.f;
+            unseen_pixels += k == 0 && cover[p] == 0.f;
+        }
+    EXPECT_GE(whole, 2) << "the moved light covers whole latent pixels";
+    EXPECT_GE(unseen_pixels, 200);
+    // The latent, tiled, decodes to white: it is the light's look, not the fit's L̃e.
+    std::vector<float> tiled;
+    for (int p = 0; p < 16 * 16; ++p) tiled.insert(tiled.end(), look.begin(), look.end());
+    const std::vector<float> rgb = vae->decode(tiled, 16, 16);
+    const size_t centre = (size_t(64) * 128 + 64) * 3;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(rgb[centre + k], 1.f, 0.08f) << k;
+}
