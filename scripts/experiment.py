@@ -202,8 +202,11 @@ def main():
     # Locally one job runs at a time (each takes every core), so the jobs' times add up to the
     # run's; on Slurm they overlap, and the line says job time only.
     cmd = snakemake_command(a, config_path, c["out"])
-    progress = P.Progress(c, c["out"], started, P.pending_jobs(cmd), clock=not a.slurm)
-    print(progress.line(), file=sys.stderr, flush=True)
+    dry_run = "--dry-run" in a.snakemake_args or "-n" in a.snakemake_args
+    # a dry run's plan is its output: Snakemake prints it once, and no job will finish
+    progress = P.Progress(c, c["out"], started, None if dry_run else P.pending_jobs(cmd), clock=not a.slurm)
+    if not dry_run:
+        print(progress.line(), file=sys.stderr, flush=True)
     returncode, stopped_by = run_workflow(cmd, lock, progress)
     if stopped_by is not None:
         print(f"experiment: stopped by {signal.Signals(stopped_by).name}; finished jobs are kept in {c['out']}: "
@@ -212,7 +215,7 @@ def main():
     if returncode != 0:
         sys.exit(f"experiment: the workflow failed (exit {returncode}); job logs in {c['out']}/<scene>/logs; "
                  "run again with the same flags to continue")
-    if "--dry-run" in a.snakemake_args or "-n" in a.snakemake_args:
+    if dry_run:
         return 0
     print(progress.line(), file=sys.stderr, flush=True)  # the last job's line: the workflow has ended
     summary = os.path.join(c["out"], "summary.md")
