@@ -165,7 +165,8 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
     char name[64];
     std::snprintf(name, sizeof name, "frame_%04d", i);
     const std::string stem = (out / name).string();
-    const bool shared = !job.frame_cache.empty() && shows_training_view(job, session, i);
+    // only with a VAE: an entry kept without one has no pictures for a job that has it
+    const bool shared = !job.frame_cache.empty() && t.vae && shows_training_view(job, session, i);
     std::optional<std::string> scores;
     if (shared) scores = take_cached_frame(job.frame_cache, training_view_key, name, stem);
     if (!scores) {

@@ -35,8 +35,8 @@ private:
     std::vector<std::vector<float>> m_looks;  ///< each one's latent (channels values)
 };
 
-/// The latent of a flat image of display colour `rgb` in the interior of its encoding (away from
-/// the encoder's borders).
+/// The latent of a flat image of display colour `rgb`: the mean over the inner half of a 64²
+/// latent encoding, away from the encoder's borders.
 std::vector<float> flat_colour_latent(const Vae& vae, const float rgb[3]);
 
 }  // namespace lpt::pipeline
