@@ -27,9 +27,10 @@ std::string temp_path_for(const std::string& path) {
         .string();
 }
 
-/// Runs `write(tmp)` on a temporary file beside `path` and renames it over `path` once complete.
+/// Runs `write(tmp)` on a temporary file beside `path` and renames it over `path` once complete;
+/// a failure removes the temporary and names `path` and `what` it is.
 template <typename Write>
-void write_atomically(const std::string& path, Write write) {
+void write_atomically(const std::string& path, Write write, const char* what = "image") {
     if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
     const std::string tmp = temp_path_for(path);
     try {
@@ -37,7 +38,7 @@ void write_atomically(const std::string& path, Write write) {
     } catch (const std::exception& e) {
         std::error_code ec;
         fs::remove(tmp, ec);
-        throw std::runtime_error(path + ": cannot write image: " + e.what());
+        throw std::runtime_error(path + ": cannot write " + what + ": " + e.what());
     }
     fs::rename(tmp, path);
 }
@@ -180,15 +181,9 @@ void write_text_atomic(const std::string& path, const std::string& contents) {
 }
 
 void copy_file_atomic(const std::string& from, const std::string& to) {
-    if (fs::path(to).has_parent_path()) fs::create_directories(fs::path(to).parent_path());
-    const std::string tmp = temp_path_for(to);
-    std::error_code ec;
-    fs::copy_file(from, tmp, fs::copy_options::overwrite_existing, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw std::runtime_error(to + ": cannot copy " + from + " there");
-    }
-    fs::rename(tmp, to);
+    write_atomically(
+        to, [&](const std::string& tmp) { fs::copy_file(from, tmp, fs::copy_options::overwrite_existing); },
+        "a copy of its file");
 }
 
 }  // namespace lpt
