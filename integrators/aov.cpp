@@ -46,43 +46,47 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
     return out;
 }
 
-std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side) {
-    Camera camera = scene.camera.with_resolution(width, height);
-    const int k = cells * cells, n = rays_per_side;
-    std::vector<float> out(size_t(width) * height * k, 0.f);
+namespace {
+
+/// Calls hit(pixel, sub-cell, first hit) for every camera ray of a regular grid: each pixel split
+/// into cells × cells sub-cells (row-major), rays_per_side² rays in each; rows in parallel.
+template <class Hit>
+void trace_pixel_grid(const Scene& scene, int width, int height, int cells, int rays_per_side, Hit hit) {
+    const Camera camera = scene.camera.with_resolution(width, height);
+    const int n = rays_per_side;
     tbb::parallel_for(0, height, [&](int y) {
         set_ftz_daz();
         for (int x = 0; x < width; ++x)
             for (int cy = 0; cy < cells; ++cy)
-                for (int cx = 0; cx < cells; ++cx) {
-                    int hits = 0;
+                for (int cx = 0; cx < cells; ++cx)
                     for (int j = 0; j < n; ++j)
                         for (int i = 0; i < n; ++i) {
                             Vec2f film(x + (cx + (i + 0.5f) / n) / cells, y + (cy + (j + 0.5f) / n) / cells);
-                            SurfaceInteraction si = scene.intersect(camera.generate_ray(film));
-                            hits += si.valid() && scene.shapes[si.shape].emitter >= 0;
+                            hit(size_t(y) * width + x, cy * cells + cx, scene.intersect(camera.generate_ray(film)));
                         }
-                    out[(size_t(y) * width + x) * k + cy * cells + cx] = float(hits) / float(n * n);
-                }
     });
+}
+
+}  // namespace
+
+std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side) {
+    const int k = cells * cells;
+    std::vector<int> hits(size_t(width) * height * k, 0);
+    trace_pixel_grid(scene, width, height, cells, rays_per_side, [&](size_t p, int cell, const SurfaceInteraction& si) {
+        hits[p * k + cell] += si.valid() && scene.shapes[si.shape].emitter >= 0;
+    });
+    std::vector<float> out(hits.size());
+    for (size_t i = 0; i < hits.size(); ++i) out[i] = float(hits[i]) / float(rays_per_side * rays_per_side);
     return out;
 }
 
 std::vector<float> render_shape_coverage(const Scene& scene, int width, int height, const std::vector<int>& shapes,
                                          int rays_per_side) {
-    Camera camera = scene.camera.with_resolution(width, height);
-    const int k = int(shapes.size()), n = rays_per_side;
+    const size_t k = shapes.size();
     std::vector<float> out(size_t(width) * height * k, 0.f);
-    tbb::parallel_for(0, height, [&](int y) {
-        set_ftz_daz();
-        for (int x = 0; x < width; ++x)
-            for (int j = 0; j < n; ++j)
-                for (int i = 0; i < n; ++i) {
-                    const SurfaceInteraction si =
-                        scene.intersect(camera.generate_ray(Vec2f(x + (i + 0.5f) / n, y + (j + 0.5f) / n)));
-                    for (int s = 0; s < k; ++s)
-                        if (si.shape == shapes[s]) out[(size_t(y) * width + x) * k + s] += 1.f / float(n * n);
-                }
+    trace_pixel_grid(scene, width, height, 1, rays_per_side, [&](size_t p, int, const SurfaceInteraction& si) {
+        for (size_t s = 0; s < k; ++s)
+            if (si.shape == shapes[s]) out[p * k + s] += 1.f / float(rays_per_side * rays_per_side);
     });
     return out;
 }
