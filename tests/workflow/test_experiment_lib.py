@@ -52,6 +52,10 @@ class Report(unittest.TestCase):
             self.assertIn('src="data:image/jpeg;base64,', cell)
             self.assertLess(len(cell), os.path.getsize(png) / 4)
             self.assertEqual(cell, X.img_tag(png, "scene/camera_eac/frame.png"), "the same bytes every run")
+            # made side by side beforehand: the same cell; files that are not there are left out
+            made = X.thumbnails([png, os.path.join(d, "missing.png"), png], 320)
+            self.assertEqual(list(made), [png])
+            self.assertEqual(cell, X.img_tag(png, "scene/camera_eac/frame.png", made=made))
 
 
 class Preset(unittest.TestCase):
