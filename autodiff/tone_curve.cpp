@@ -94,6 +94,21 @@ float tone(ToneCurve kind, float x) {
     return x < 0.0f ? -curve(kind, -x) : curve(kind, x);
 }
 
+float tone_inverse(ToneCurve kind, float y) {
+    if (kind == ToneCurve::Logit) return std::clamp(1.0f / (1.0f + std::exp(-y)), k_logit_eps, 1.0f - k_logit_eps);
+    const float b = std::abs(y);
+    float a = b;
+    if (kind == ToneCurve::Clip) {
+        a = std::pow(b / k_clip_scale, 1.0f / k_gamma);
+        a = std::min(a, k_clip_max);
+    } else if (kind == ToneCurve::Reinhard) {
+        // c(a) = 4 u^γ with u = a / (1 + a) < 1: a = u / (1 − u)
+        const float u = std::min(std::pow(b / k_reinhard_scale, 1.0f / k_gamma), 1.0f - 1e-6f);
+        a = u / (1.0f - u);
+    }
+    return y < 0.0f ? -a : a;
+}
+
 float d_tone(ToneCurve kind, float x) {
     // Logit: 1 / (x (1 − x)) inside [eps, 1 − eps], 0 where the clamp holds (the true
     // derivative). A surrogate slope there (the clamp's, ~1e4) let the few pixels that see a

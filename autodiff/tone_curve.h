@@ -30,6 +30,9 @@ const char* to_string(ToneCurve curve);
 
 /// T(x), odd in x. docs/fitting.md (1).
 float tone(ToneCurve curve, float x);
+/// The x with T(x) = y, y first brought into T's range (clip: |x| ≤ 3; reinhard: |y| < 4; logit:
+/// y's sigmoid within [eps, 1 − eps]): edits give a render a latent the VAE made.
+float tone_inverse(ToneCurve curve, float y);
 /// dT/dx, even in x, finite everywhere (0 where clip saturates, |x| > 3). docs/fitting.md (3), (5), (6).
 float d_tone(ToneCurve curve, float x);
 

@@ -59,6 +59,22 @@ TEST(ToneCurve, OddValueEvenDerivative) {
         }
 }
 
+TEST(ToneCurve, InverseUndoesTheCurveAndClampsToItsRange) {
+    for (ToneCurve c : {ToneCurve::Clip, ToneCurve::Reinhard, ToneCurve::None, ToneCurve::Logit})
+        for (float x : {1e-3f, 0.05f, 0.3f, 1.0f, 2.9f}) {
+            const float xs = c == ToneCurve::Logit ? x / 3.f : x;  // logit's domain is (0, 1)
+            for (float v : {xs, c == ToneCurve::Logit ? xs : -xs})
+                EXPECT_NEAR(tone_inverse(c, tone(c, v)), v, 2e-5f * std::max(1.f, std::abs(v)))
+                    << to_string(c) << " x=" << v;
+        }
+    // past the curve's range: the end of the domain that T maps furthest
+    EXPECT_EQ(tone_inverse(ToneCurve::Clip, 6.f), 3.f);
+    EXPECT_EQ(tone_inverse(ToneCurve::Clip, -6.f), -3.f);
+    EXPECT_GT(tone_inverse(ToneCurve::Reinhard, 5.f), 1e3f);
+    EXPECT_TRUE(std::isfinite(tone_inverse(ToneCurve::Reinhard, 5.f)));
+    EXPECT_NEAR(tone_inverse(ToneCurve::Logit, 40.f), 1.f - k_logit_eps, 1e-7f);
+}
+
 // Float evaluations, differenced in double with a step relative to |x|: the rounding error
 // (~6e-8 · |T| / h) and truncation error (~0.14 (h/x)²) both stay near 1e-5.
 TEST(ToneCurve, DerivativeMatchesCentralDifferences) {
