@@ -28,7 +28,7 @@ std::vector<float> render_emitter_cells(const Scene& scene, int width, int heigh
 
 /// The fraction of each pixel whose camera ray first hits each shape of `shapes`, from a regular
 /// grid of rays_per_side² rays per pixel (geometry, deterministic): width × height × shapes.size()
-/// values, the shapes' in their order per pixel.
+/// values, the shapes' in their order per pixel. A shape of -1 counts the rays that hit nothing.
 std::vector<float> render_shape_coverage(const Scene& scene, int width, int height, const std::vector<int>& shapes,
                                          int rays_per_side = 8);
 

@@ -6,13 +6,27 @@
 #include "integrators/path.h"
 #include "integrators/path_events.h"
 #include "integrators/wavefront_state.h"
+#include <stdexcept>
 
 namespace lpt {
 
 template <int N>
 class LatentStage {
 public:
-    LatentStage(const LatentTerms<N>& terms, PathObserver<N>* observer) : m_terms(terms), m_obs(observer) {}
+    LatentStage(const LatentTerms<N>& terms, PathObserver<N>* observer) : m_terms(terms), m_obs(observer) {
+        if (observer && !terms.looks.empty())
+            throw std::invalid_argument("LatentTerms::looks in a render with an observer");
+    }
+
+    /// A camera ray met `shape` (-1: nothing; an emitter from its emitting side): with a look
+    /// for it (LatentTerms::looks) it scores that into Ĩa and the path ends (true); else false.
+    bool camera_look(PathState<N>& p, uint32_t slot, int shape) const {
+        if (m_terms.looks.empty()) return false;
+        const int i = shape < 0 ? m_terms.look_of_nothing : m_terms.look_of_shape[shape];
+        if (i < 0) return false;
+        p.ambient[slot] += ambient_score(p.beta[slot], m_terms.looks[i]);
+        return true;
+    }
 
     /// A path escaped (or met a surface's black side, see hit()): the background joins Ĩa
     /// unless a non-delta vertex came before.

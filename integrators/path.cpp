@@ -166,6 +166,7 @@ private:
         for (size_t i = 0; i < rays.size; ++i) {
             const uint32_t slot = ws.queue[cur][i];
             if (!rays.hit(i)) {
+                if (depth == 0 && m_latent && m_latent->camera_look(p, slot, -1)) continue;
                 if (m_latent) m_latent->escaped(p, slot);
                 if (env < 0 || !m_emission) continue;
                 const Vec3f dir = rays.direction(i);
@@ -184,9 +185,12 @@ private:
             const Shape& shape = m_scene.shapes[shape_id];
             SurfaceInteraction si = shape.interaction(rays.prim[i], rays.u[i], rays.v[i], rays.tfar[i]);
             const Vec3f wi_world = -rays.direction(i);
-            if (shape.emitter >= 0 && m_emission) {
-                Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
-                if (ne.dot(wi_world) > 0.f) {
+            if (shape.emitter >= 0) {
+                const Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
+                const bool front = ne.dot(wi_world) > 0.f;
+                // an emitter the training view never showed, in the look an edit gives it
+                if (front && depth == 0 && m_latent && m_latent->camera_look(p, slot, shape_id)) continue;
+                if (front && m_emission) {
                     float light_pdf =
                         m_scene.lights.pmf(shape.emitter) * pdf_area_light(shape, p.prev_p[slot], si.p, ne);
                     float w = hit_weight(p, slot, light_pdf);

@@ -48,6 +48,14 @@ template <int N>
 struct LatentTerms {
     std::vector<Spectrum<N>, Eigen::aligned_allocator<Spectrum<N>>> La, Lc;  ///< per shape
     Spectrum<N> background = Spectrum<N>::Zero();  ///< camera paths escaping along delta bounces
+    /// Edits only (pipeline/unseen_emitters.h): what a camera ray scores, into Ĩa and nothing
+    /// else, where it first meets what the training view never showed: looks[look_of_shape[s]]
+    /// on the emitting side of shape s (where that index is ≥ 0), looks[look_of_nothing] where it
+    /// hits nothing. Empty and -1: none. Never in a render with an observer (a fit's adjoint does
+    /// not know them).
+    std::vector<int> look_of_shape;
+    int look_of_nothing = -1;
+    std::vector<Spectrum<N>, Eigen::aligned_allocator<Spectrum<N>>> looks;
     OcclusionGate gate = OcclusionGate::Shadowed;
     bool emission = true, ambient = true, occlusion = true;  ///< which of Ĩe, Ĩa, Ĩc to render
 };

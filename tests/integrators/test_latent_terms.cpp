@@ -171,3 +171,60 @@ TEST(LatentTerms, TheBackOfAOneSidedSurfaceShowsTheBackground) {
     for (size_t i = 0; i < a2.size(); ++i) EXPECT_NEAR(a2[i], la[int(i % 16)], 1e-6f);
     EXPECT_GT(max_abs(c2), 0.1f) << "the plane shadows itself from below: Ĩc must count there";
 }
+
+// Edits of what the training view never showed (LatentTerms::looks): camera rays that hit
+// nothing, or the emitting side of a shape given a look, score that look into Ĩa and nothing
+// else (no environment L̃e, no b̃, no emission); every other pixel renders exactly as before.
+TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
+    // Looking straight down at the edge (x = 100) of a plane that emits upwards: half of the
+    // pixels see the plane, the others nothing but the constant environment.
+    const std::string json = R"({
+      "integrator": {"max_depth": 3, "rr_depth": 100},
+      "camera": {"fov": 20, "width": 8, "height": 8, "filter": {"type": "box"}, "near_clip": 1e-4,
+                 "to_world": {"lookat": {"origin": [100, 0, 1], "target": [100, 0, 0], "up": [0, 1, 0]}}},
+      "materials": {"plane": {"type": "diffuse", "reflectance": 0.5}},
+      "shapes": [{"id": "plane", "type": "rectangle", "material": "plane", "to_world": {"scale": [100, 100, 1]},
+                  "emitter": {"type": "area", "radiance": 3}}],
+      "emitters": [{"type": "constant", "radiance": 2}]
+    })";
+    const Scene scene = load_scene(test::write_temp_file("plane_edge.json", json));
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    const int plane = scene.find_shape("plane");
+    LatentTerms<16> t = zero_terms(scene);
+    const S16 la = ramp(-0.3f, 0.8f), v_nothing = ramp(1.5f, -2.f), v_plane = ramp(-1.f, 0.5f);
+    t.La[plane] = la;
+    t.background = ramp(0.2f, -0.6f);
+    const TermFilms<16> before = render_latent_terms<16>(scene, spectra, t, options(scene));
+    for (const bool plane_look : {false, true}) {
+        LatentTerms<16> u = t;
+        u.looks = {v_nothing, v_plane};
+        u.look_of_nothing = 0;
+        u.look_of_shape.assign(scene.shapes.size(), -1);
+        if (plane_look) u.look_of_shape[plane] = 1;
+        const TermFilms<16> after = render_latent_terms<16>(scene, spectra, u, options(scene));
+        const std::vector<float> e0 = before.e.develop(), a0 = before.a.develop(), c0 = before.c.develop();
+        const std::vector<float> e1 = after.e.develop(), a1 = after.a.develop(), c1 = after.c.develop();
+        const S16 env = spectra.radiance[scene.environment];
+        int surface = 0, nothing = 0;
+        for (size_t p = 0; p < e0.size() / 16; ++p) {
+            const bool missed = std::abs(a0[p * 16] - t.background[0]) < 1e-6f;  // la[0] = −0.3, b̃[0] = 0.2
+            surface += !missed;
+            nothing += missed;
+            for (int k = 0; k < 16; ++k) {
+                const size_t i = p * 16 + k;
+                if (missed) EXPECT_NEAR(e0[i], env[k], 1e-6f) << "before: the environment, seen directly";
+                if (missed || plane_look) {
+                    EXPECT_NEAR(a1[i], (missed ? v_nothing : v_plane)[k], 1e-6f) << p;
+                    EXPECT_EQ(e1[i], 0.f) << p;
+                    EXPECT_EQ(c1[i], 0.f) << p;
+                } else {
+                    EXPECT_EQ(e1[i], e0[i]) << p;
+                    EXPECT_EQ(a1[i], a0[i]) << p;
+                    EXPECT_EQ(c1[i], c0[i]) << p;
+                }
+            }
+        }
+        EXPECT_EQ(surface, 32);
+        EXPECT_EQ(nothing, 32);
+    }
+}
