@@ -204,7 +204,9 @@ std::string frame_hash(const EditJob& job, const EditSession& session, bool with
         std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp) +
         reference_seed_suffix(job.ref_seed));     // empty for the default seed: keys as before
     if (job.reference) add(kEditedFrameSeedTag);  // edited frames' references changed seeds: score them again
-    if (!session.unseen_emitters().empty()) add("unseen emitters painted");  // their frames changed (session 41)
+    // their edited frames changed: unseen emitters painted (session 41), then rendered in their looks (42)
+    if (!session.unseen_emitters().empty() || session.unseen_emitters().environment_unseen())
+        add("unseen emitters rendered in their looks");
     char buf[40];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
     return buf;
@@ -236,6 +238,10 @@ int render_edits(const EditJob& job, const Reporter& report) {
     for (int shape : session.unseen_emitters().shapes())
         report.say("note: the training view does not show emitter '" + session.fit().scene->shapes[shape].id +
                    "': frames show it in its display colour (docs/edits.md)");
+    if (session.unseen_emitters().environment_unseen())
+        report.say(std::string("note: the training view does not show ") +
+                   (session.fit().scene->environment >= 0 ? "the environment" : "the void (no environment: black)") +
+                   ": frames show it in its display colour where they look past every surface (docs/edits.md)");
     const fs::path out(job.out);
     fs::create_directories(out);
     std::ostringstream csv;

@@ -11,26 +11,20 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The already edited scene of `fit` at spp with seed, refined when `refiner` is given, and by
-/// `emitters` (when given) where emitters are seen otherwise than `training_coverage` says;
-/// `unseen` emitters painted into the latent before refinement and into its output.
+/// `emitters` (when given) where emitters are seen otherwise than `training_coverage` says.
 FrameLatents edited_frame(const FitFolder& fit, const Refiner* refiner, const Refiner* emitters,
-                          const std::vector<float>& training_coverage, const UnseenEmitters& unseen, int width,
-                          int height, int spp, uint64_t seed) {
+                          const std::vector<float>& training_coverage, int width, int height, int spp, uint64_t seed) {
     FrameLatents f;
     f.width = width;
     f.height = height;
-    const std::vector<float> cover = unseen.empty() ? std::vector<float>() : unseen.coverage(*fit.scene, width, height);
     if (!refiner) {
         f.latent = render_fit_latent(fit, width, height, spp, seed);
-        unseen.paint(cover, width, height, f.latent);
         return f;
     }
     // Same spp and seed as the fit's latent: an identity edit reproduces its refined latent.
     f.view = fit_refiner_view(fit, refiner->config(), width, height, spp, seed);
-    unseen.paint(cover, width, height, f.view.latent);
     f.latent = f.view.latent;
     f.refined = refine_with_emitters(*refiner, emitters, *fit.scene, f.view, training_coverage);
-    unseen.paint(cover, width, height, f.refined);
     return f;
 }
 
@@ -62,7 +56,8 @@ FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int he
         throw std::invalid_argument("frame " + std::to_string(i) +
                                     " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
     apply_edits(m_edits, time(i), m_original, m_camera, *m_fit.scene);
-    return edited_frame(m_fit, m_refiner.get(), m_emitter_refiner.get(), m_training_coverage, m_unseen,
+    m_unseen.show(m_fit.model->terms(), m_fit.tone, m_fit.scene->shapes.size(), !unedited(i));
+    return edited_frame(m_fit, m_refiner.get(), m_emitter_refiner.get(), m_training_coverage,
                         width > 0 ? width : m_fit.latent_width, height > 0 ? height : m_fit.latent_height, spp,
                         seed + uint64_t(i));
 }

@@ -43,8 +43,8 @@ public:
     bool unedited(int i) const { return is_unedited(m_edits, time(i)); }
     /// The fit, its scene as the last frame() left it (for path-traced references of that frame).
     const FitFolder& fit() const { return m_fit; }
-    /// Emitters the training view does not show, whose look frames take from the VAE
-    /// (pipeline/unseen_emitters.h); none in most scenes.
+    /// Emitters (the environment among them) the training view does not show, which edited
+    /// frames render in looks from the VAE (pipeline/unseen_emitters.h).
     const UnseenEmitters& unseen_emitters() const { return m_unseen; }
 
 private:

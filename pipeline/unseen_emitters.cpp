@@ -1,8 +1,10 @@
 #include "pipeline/unseen_emitters.h"
+#include "autodiff/tone_curve.h"
 #include "integrators/aov.h"
 #include "pipeline/reference.h"
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 
@@ -25,45 +27,64 @@ std::vector<float> flat_colour_latent(const Vae& vae, const float rgb[3]) {
     return mean;
 }
 
+namespace {
+
+/// What a camera ray that hits nothing brings back in RGB: the environment's radiance (an
+/// environment map's mean), black without one.
+Eigen::Array3f environment_radiance(const Scene& scene) {
+    return scene.environment >= 0 ? scene.emitters[scene.environment].radiance_rgb : Eigen::Array3f::Zero();
+}
+
+}  // namespace
+
 UnseenEmitters::UnseenEmitters(const FitFolder& fit) {
     if (!vae_present(fit.vae)) return;
     const Scene& scene = *fit.scene;
-    std::vector<int> emitters;
+    std::vector<int> candidates;  // the area emitters' shapes, then -1: rays that hit nothing
+    std::vector<Eigen::Array3f> radiance;
     for (const Emitter& e : scene.emitters)
-        if (!e.is_environment() && e.shape >= 0) emitters.push_back(e.shape);
-    if (emitters.empty()) return;
-    const int w = fit.latent_width, h = fit.latent_height;
-    const std::vector<float> seen = render_shape_coverage(scene, w, h, emitters);
+        if (!e.is_environment() && e.shape >= 0) {
+            candidates.push_back(e.shape);
+            radiance.push_back(e.radiance_rgb);
+        }
+    candidates.push_back(-1);
+    radiance.push_back(environment_radiance(scene));
+    // At least 256 rays across the narrower side: 8 × 8 per pixel of a tiny test latent stepped
+    // over the gap between a box and the view's edge that the render's samples fell through.
+    const int w = fit.latent_width, h = fit.latent_height, rays = std::max(8, (255 + std::min(w, h)) / std::min(w, h));
+    const std::vector<float> seen = render_shape_coverage(scene, w, h, candidates, rays);
     std::unique_ptr<Vae> vae;
-    for (size_t s = 0; s < emitters.size(); ++s) {
+    for (size_t s = 0; s < candidates.size(); ++s) {
         bool any = false;
-        for (size_t p = 0; p < size_t(w) * h && !any; ++p) any = seen[p * emitters.size() + s] > 0.f;
+        for (size_t p = 0; p < size_t(w) * h && !any; ++p) any = seen[p * candidates.size() + s] > 0.f;
         if (any) continue;
-        const Emitter& e = scene.emitters[scene.shapes[emitters[s]].emitter];
         float rgb[3];
-        for (int k = 0; k < 3; ++k) rgb[k] = display_value(e.radiance_rgb[k], fit.ref_tone);
+        for (int k = 0; k < 3; ++k) rgb[k] = display_value(radiance[s][k], fit.ref_tone);
         if (!vae) vae = open_vae(fit.vae);
-        m_shapes.push_back(emitters[s]);
-        m_looks.push_back(flat_colour_latent(*vae, rgb));
+        std::vector<float> look = flat_colour_latent(*vae, rgb);
+        if (candidates[s] < 0) {
+            m_environment = std::move(look);
+        } else {
+            m_shapes.push_back(candidates[s]);
+            m_looks.push_back(std::move(look));
+        }
     }
 }
 
-std::vector<float> UnseenEmitters::coverage(const Scene& scene, int w, int h) const {
-    return render_shape_coverage(scene, w, h, m_shapes);
-}
-
-void UnseenEmitters::paint(const std::vector<float>& coverage, int w, int h, std::vector<float>& latent) const {
-    const size_t n = m_shapes.size(), pixels = size_t(w) * h;
-    if (n == 0) return;
-    const size_t c = m_looks[0].size();
-    if (latent.size() != pixels * c || coverage.size() != pixels * n)
-        throw std::invalid_argument("UnseenEmitters::paint: latent or coverage of another size");
-    for (size_t p = 0; p < pixels; ++p)
-        for (size_t s = 0; s < n; ++s) {
-            const float a = coverage[p * n + s];
-            if (a <= 0.f) continue;
-            for (size_t k = 0; k < c; ++k) latent[p * c + k] = (1.f - a) * latent[p * c + k] + a * m_looks[s][k];
-        }
+void UnseenEmitters::show(LatentTerms<kLatentChannels>& terms, ToneCurve tone, size_t shapes, bool on) const {
+    terms.look_of_shape.clear();
+    terms.look_of_nothing = -1;
+    terms.looks.clear();
+    if (!on || (m_shapes.empty() && !m_environment)) return;
+    auto add = [&](const std::vector<float>& look) {
+        Spectrum<kLatentChannels> x;
+        for (int k = 0; k < kLatentChannels; ++k) x[k] = tone_inverse(tone, look[k]);
+        terms.looks.push_back(x);
+        return int(terms.looks.size()) - 1;
+    };
+    terms.look_of_shape.assign(shapes, -1);
+    for (size_t s = 0; s < m_shapes.size(); ++s) terms.look_of_shape[m_shapes[s]] = add(m_looks[s]);
+    if (m_environment) terms.look_of_nothing = add(*m_environment);
 }
 
 }  // namespace lpt::pipeline

@@ -1,12 +1,18 @@
 // Emitters the training view never shows (a pendant lamp's bulb inside its shade): the fit saw
 // the light they cast but not what they look like, and their L̃e seen directly decodes to noise
-// (a rainbow disk where Living Room's raised bulb comes into view). Where an edited view sees
-// one, its latent pixels take the VAE's encoding of the emitter's display colour instead,
-// blended by how much of each pixel it covers (docs/edits.md "Emitters the training view does
-// not show"). Emitters the training view shows keep their fitted look: scenes without unseen
-// emitters render as before, byte for byte.
+// (a rainbow disk where Living Room's raised bulb comes into view). The environment is one too:
+// camera rays that hit nothing see it (black in a scene without one), and a camera orbit past a
+// closed room's walls shows what the training view never did (Lamp's b̃ decoded to brown stripes
+// there). Edited frames render each in its look, the VAE's encoding of its display colour, for
+// the camera rays that meet it (LatentTerms::looks; docs/edits.md "Emitters the training view
+// does not show"). Emitters the training view shows keep their fitted look, and a frame that is
+// the training view is rendered without looks.
 #pragma once
+#include "autodiff/tone_curve.h"
+#include "integrators/path.h"
+#include "latent/latent.h"
 #include "pipeline/fit_folder.h"
+#include <optional>
 #include <vector>
 
 namespace lpt {
@@ -18,21 +24,25 @@ namespace lpt::pipeline {
 class UnseenEmitters {
 public:
     UnseenEmitters() = default;
-    /// The area emitters of `fit`'s scene (as loaded: the training view) that no latent pixel of
-    /// it sees, and each one's latent from the fit's VAE (opened only if there are any). None
-    /// when the VAE is not here (frames are then latents only, nothing decodes them).
+    /// The area emitters of `fit`'s scene (as loaded: the training view) that no camera ray of it
+    /// meets, the environment if every one meets a surface, and the latent of each from the fit's
+    /// VAE (opened only if there are any). None when the VAE is not here (frames are then latents
+    /// only, nothing decodes them).
     explicit UnseenEmitters(const FitFolder& fit);
+    /// No unseen area emitter (the environment aside).
     bool empty() const { return m_shapes.empty(); }
+    /// The unseen area emitters' shapes.
     const std::vector<int>& shapes() const { return m_shapes; }
-    /// Their coverage of the scene's current view at w × h (render_shape_coverage).
-    std::vector<float> coverage(const Scene& scene, int w, int h) const;
-    /// latent ← (1 − c) latent + c · the emitter's latent, per pixel and unseen emitter with
-    /// coverage c; `latent` is tone-mapped (what the VAE reads), w × h × channels.
-    void paint(const std::vector<float>& coverage, int w, int h, std::vector<float>& latent) const;
+    bool environment_unseen() const { return m_environment.has_value(); }
+    /// Gives `terms` (of a scene with `shapes` shapes) the looks, as linear latents under `tone`
+    /// (the renderer mixes a look into a pixel in proportion to its rays that meet it, before the
+    /// tone curve, as it mixes everything else); with `on` false, takes them away.
+    void show(LatentTerms<kLatentChannels>& terms, ToneCurve tone, size_t shapes, bool on) const;
 
 private:
-    std::vector<int> m_shapes;                ///< the unseen emitters' shapes
-    std::vector<std::vector<float>> m_looks;  ///< each one's latent (channels values)
+    std::vector<int> m_shapes;                        ///< the unseen emitters' shapes
+    std::vector<std::vector<float>> m_looks;          ///< each one's latent (channels values)
+    std::optional<std::vector<float>> m_environment;  ///< the environment's latent, when unseen
 };
 
 /// The latent of a flat image of display colour `rgb`: the mean over the inner half of a 64²

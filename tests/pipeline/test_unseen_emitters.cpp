@@ -1,8 +1,9 @@
 // Emitters the training view does not show (pipeline/unseen_emitters.h): a second light hidden
-// behind the box's back wall and moved into view by an edit. Its coverage is the emitter cells'
-// geometry, the frame's latent takes the flat colour's latent exactly where it covers whole
-// pixels and keeps the render wherever it is not seen, and that latent decodes to the light's
-// display colour; the box's own light, which training sees, is never painted.
+// behind the box's back wall and moved into view by an edit. The frame's latent is the flat
+// colour's latent where the light covers whole pixels and the render without looks wherever it
+// is not seen, and that latent decodes to the light's display colour; the box's own light,
+// which training sees, keeps its fitted look.
+#include "autodiff/fit.h"
 #include "core/image_io.h"
 #include "core/scene_loader.h"
 #include "integrators/aov.h"
@@ -44,6 +45,15 @@ int shape_index(const Scene& scene, const std::string& id) {
     return -1;
 }
 
+/// The fit's latent of its scene as it stands, as render_fit_latent renders it but without the
+/// looks an EditSession gives its terms.
+std::vector<float> without_looks(const pipeline::FitFolder& fit, int w, int h, int spp, uint64_t seed) {
+    LatentTerms<kLatentChannels> terms = fit.model->terms();
+    terms.looks.clear();
+    const RenderOptions options = RenderOptions::from_scene(*fit.scene, w, h, spp, seed);
+    return toned_sum(render_latent_terms<kLatentChannels>(*fit.scene, fit.model->spectra(), terms, options), fit.tone);
+}
+
 }  // namespace
 
 TEST(UnseenEmitters, ShapeCoverageIsTheEmitterCellsOfTheOnlyEmitter) {
@@ -62,7 +72,7 @@ TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
     const std::string dir = test::temp_dir("unseen-emitters");
     pipeline::FitJob job;
     job.scene = box_with_a_hidden_light(dir);
-    job.defines = {{"integrator.max_depth", "3"}};
+    job.defines = {{"integrator.max_depth", "3"}, {"camera.filter.type", "box"}};  // a pixel's samples inside it
     job.out = dir + "/fit";
     job.synthetic_res = "16x16";
     job.options.iterations = 5;
@@ -79,8 +89,8 @@ TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
     ASSERT_EQ(unseen.shapes(), std::vector<int>{hidden}) << "the box's own light is seen in training";
 
     const pipeline::FrameLatents f = session.frame(1, 2, 0);  // moved by 1.5: in front of the back wall
-    const std::vector<float> cover = unseen.coverage(*session.fit().scene, 16, 16);
-    const std::vector<float> raw = pipeline::render_fit_latent(session.fit(), 16, 16, 2, 1);  // seed + frame
+    const std::vector<float> cover = render_shape_coverage(*session.fit().scene, 16, 16, {hidden});
+    const std::vector<float> raw = without_looks(session.fit(), 16, 16, 2, 1);  // seed + frame
     const std::unique_ptr<Vae> vae = pipeline::open_vae(session.fit().vae);
     const float white[3] = {1.f, 1.f, 1.f};  // radiance (17, 12, 4) clipped
     const std::vector<float> look = pipeline::flat_colour_latent(*vae, white);
@@ -88,22 +98,61 @@ TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
     for (size_t p = 0; p < cover.size(); ++p)
         for (int k = 0; k < 16; ++k) {
             const float got = f.latent[p * 16 + k];
-            if (cover[p] == 1.f) {
-                EXPECT_EQ(got, look[k]) << p;
-            } else if (cover[p] == 0.f) {
-                EXPECT_EQ(got, raw[p * 16 + k]) << p;
-            } else {
-                EXPECT_NEAR(got, (1.f - cover[p]) * raw[p * 16 + k] + cover[p] * look[k], 1e-5f) << p;
-            }
+            if (cover[p] == 1.f) EXPECT_NEAR(got, look[k], 1e-4f) << p;  // through the tone curve and back
+            if (cover[p] == 0.f) EXPECT_EQ(got, raw[p * 16 + k]) << p;
             whole += k == 0 && cover[p] == 1.f;
             unseen_pixels += k == 0 && cover[p] == 0.f;
         }
     EXPECT_GE(whole, 2) << "the moved light covers whole latent pixels";
     EXPECT_GE(unseen_pixels, 200);
+    const std::vector<float> training = session.frame(0, 2, 0).latent;  // the scene back at rest, first
+    EXPECT_EQ(training, pipeline::render_fit_latent(session.fit(), 16, 16, 2, 0)) << "rendered without looks";
     // The latent, tiled, decodes to white: it is the light's look, not the fit's L̃e.
     std::vector<float> tiled;
     for (int p = 0; p < 16 * 16; ++p) tiled.insert(tiled.end(), look.begin(), look.end());
     const std::vector<float> rgb = vae->decode(tiled, 16, 16);
     const size_t centre = (size_t(64) * 128 + 64) * 3;
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(rgb[centre + k], 1.f, 0.08f) << k;
+}
+
+// The environment the training view does not show: the bundled box, narrowed to fill its view,
+// and the camera panned past its walls. Latent pixels that see nothing but the void take the
+// latent of black (no environment), through the tone curve; the training view is the fit's own
+// render bit for bit.
+TEST(UnseenEmitters, ACameraPannedPastTheWallsSeesTheVoidAsBlack) {
+    if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
+    const std::string dir = test::temp_dir("unseen-environment");
+    pipeline::FitJob job;
+    job.scene = kBox;
+    job.defines = {{"integrator.max_depth", "3"}, {"camera.fov", "25"}};  // the box fills the view
+    job.out = dir + "/fit";
+    job.synthetic_res = "16x16";
+    job.options.iterations = 5;
+    job.options.spp = 2;
+    job.final_spp = 2;
+    job.refiner = false;
+    pipeline::run_fit(job);
+    const std::string edits = test::write_temp_file(
+        "pan.json", R"({ "frames": 2, "camera": { "orbit": { "azimuth": [0, 40], "pivot": [2.78, 2.73, -8] } } })");
+    pipeline::EditSession session(job.out, edits);
+    ASSERT_TRUE(session.unseen_emitters().environment_unseen()) << "the box fills its training view";
+    const std::vector<float> training = session.frame(0, 2, 0).latent;  // the scene at rest, first
+    EXPECT_EQ(training, pipeline::render_fit_latent(session.fit(), 16, 16, 2, 0));
+
+    const pipeline::FrameLatents f = session.frame(1, 2, 0);  // panned by 20°: the box's right half, then nothing
+    const std::vector<float> nothing = render_shape_coverage(*session.fit().scene, 16, 16, {-1});
+    const std::unique_ptr<Vae> vae = pipeline::open_vae(session.fit().vae);
+    const float black[3] = {0.f, 0.f, 0.f};
+    const std::vector<float> look = pipeline::flat_colour_latent(*vae, black);
+    int void_pixels = 0, seen_pixels = 0;
+    for (size_t p = 0; p < nothing.size(); ++p) {
+        if (nothing[p] < 1.f) {
+            seen_pixels += nothing[p] == 0.f;
+            continue;
+        }
+        ++void_pixels;
+        for (int k = 0; k < 16; ++k) EXPECT_NEAR(f.latent[p * 16 + k], look[k], 1e-4f) << p << " " << k;
+    }
+    EXPECT_GE(void_pixels, 16) << "the orbit looks past the box";
+    EXPECT_GE(seen_pixels, 16);
 }
