@@ -45,6 +45,23 @@ int shape_index(const Scene& scene, const std::string& id) {
     return -1;
 }
 
+/// A 16² latent fit of `scene` in dir/fit, 5 iterations at 2 spp, no refiner, with `defines`.
+pipeline::FitJob small_fit(const std::string& scene, std::map<std::string, std::string> defines,
+                           const std::string& dir) {
+    pipeline::FitJob job;
+    job.scene = scene;
+    defines["integrator.max_depth"] = "3";
+    job.defines = defines;
+    job.out = dir + "/fit";
+    job.synthetic_res = "16x16";
+    job.options.iterations = 5;
+    job.options.spp = 2;
+    job.final_spp = 2;
+    job.refiner = false;
+    pipeline::run_fit(job);
+    return job;
+}
+
 /// The fit's latent of its scene as it stands, as render_fit_latent renders it but without the
 /// looks an EditSession gives its terms.
 std::vector<float> without_looks(const pipeline::FitFolder& fit, int w, int h, int spp, uint64_t seed) {
@@ -70,16 +87,8 @@ TEST(UnseenEmitters, ShapeCoverageIsTheEmitterCellsOfTheOnlyEmitter) {
 TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
     if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
     const std::string dir = test::temp_dir("unseen-emitters");
-    pipeline::FitJob job;
-    job.scene = box_with_a_hidden_light(dir);
-    job.defines = {{"integrator.max_depth", "3"}, {"camera.filter.type", "box"}};  // a pixel's samples inside it
-    job.out = dir + "/fit";
-    job.synthetic_res = "16x16";
-    job.options.iterations = 5;
-    job.options.spp = 2;
-    job.final_spp = 2;
-    job.refiner = false;
-    pipeline::run_fit(job);
+    // a box filter: a pixel's samples stay inside it, so whole pixels show nothing but the light
+    const pipeline::FitJob job = small_fit(box_with_a_hidden_light(dir), {{"camera.filter.type", "box"}}, dir);
     const std::string edits = test::write_temp_file(
         "lower.json",
         R"({ "frames": 2, "shapes": [ { "id": "hidden_light", "translate": [[0, 0, 0], [0, 0, -3]] } ] })");
@@ -122,16 +131,7 @@ TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
 TEST(UnseenEmitters, ACameraPannedPastTheWallsSeesTheVoidAsBlack) {
     if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
     const std::string dir = test::temp_dir("unseen-environment");
-    pipeline::FitJob job;
-    job.scene = kBox;
-    job.defines = {{"integrator.max_depth", "3"}, {"camera.fov", "25"}};  // the box fills the view
-    job.out = dir + "/fit";
-    job.synthetic_res = "16x16";
-    job.options.iterations = 5;
-    job.options.spp = 2;
-    job.final_spp = 2;
-    job.refiner = false;
-    pipeline::run_fit(job);
+    const pipeline::FitJob job = small_fit(kBox, {{"camera.fov", "25"}}, dir);  // the box fills the view
     const std::string edits = test::write_temp_file(
         "pan.json", R"({ "frames": 2, "camera": { "orbit": { "azimuth": [0, 40], "pivot": [2.78, 2.73, -8] } } })");
     pipeline::EditSession session(job.out, edits);
