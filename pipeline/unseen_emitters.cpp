@@ -49,8 +49,8 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit) {
         }
     candidates.push_back(-1);
     radiance.push_back(environment_radiance(scene));
-    // At least 256 rays across the narrower side: 8 × 8 per pixel of a tiny test latent stepped
-    // over the gap between a box and the view's edge that the render's samples fell through.
+    // At least 256 rays across the narrower side: on a latent of a few pixels, 8 × 8 per pixel
+    // could step over a gap between a wall and the view's edge that the render's samples find.
     const int w = fit.latent_width, h = fit.latent_height, rays = std::max(8, (255 + std::min(w, h)) / std::min(w, h));
     const std::vector<float> seen = render_shape_coverage(scene, w, h, candidates, rays);
     std::unique_ptr<Vae> vae;
