@@ -22,7 +22,8 @@ public:
     /// for it (LatentTerms::looks) it scores that into Ĩa and the path ends (true); else false.
     bool camera_look(PathState<N>& p, uint32_t slot, int shape) const {
         if (m_terms.looks.empty()) return false;
-        const int i = shape < 0 ? m_terms.look_of_nothing : m_terms.look_of_shape[shape];
+        const std::vector<int>& of_shape = m_terms.look_of_shape;  // empty: no shape has one
+        const int i = shape < 0 ? m_terms.look_of_nothing : size_t(shape) < of_shape.size() ? of_shape[shape] : -1;
         if (i < 0) return false;
         p.ambient[slot] += ambient_score(p.beta[slot], m_terms.looks[i]);
         return true;

@@ -199,8 +199,10 @@ TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
         LatentTerms<16> u = t;
         u.looks = {v_nothing, v_plane};
         u.look_of_nothing = 0;
-        u.look_of_shape.assign(scene.shapes.size(), -1);
-        if (plane_look) u.look_of_shape[plane] = 1;
+        if (plane_look) {  // else look_of_shape stays empty: no shape has a look
+            u.look_of_shape.assign(scene.shapes.size(), -1);
+            u.look_of_shape[plane] = 1;
+        }
         const TermFilms<16> after = render_latent_terms<16>(scene, spectra, u, options(scene));
         const std::vector<float> e0 = before.e.develop(), a0 = before.a.develop(), c0 = before.c.develop();
         const std::vector<float> e1 = after.e.develop(), a1 = after.a.develop(), c1 = after.c.develop();
