@@ -1,7 +1,7 @@
-// The adjoint of integrators/path.cpp: the tracer runs again with the primal's random numbers
-// and a PathRecorder attached; each finished wavefront's records are swept backwards at once
-// (detail::backward_block) and forgotten, so memory stays one wavefront however many samples
-// there are. docs/path-replay.md (1)–(6).
+// The adjoint of the wavefront tracer (integrators/path_tracer.cpp): the tracer runs again with
+// the primal's random numbers and a PathRecorder attached; each finished wavefront's records are
+// swept backwards at once (detail::backward_block) and forgotten, so memory stays one wavefront
+// however many samples there are. docs/path-replay.md (1)–(6).
 #include "autodiff/latent_path_adjoint.h"
 #include "autodiff/path_record.h"
 #include <stdexcept>

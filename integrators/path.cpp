@@ -1,6 +1,7 @@
 // The driver: splits the image into tiles, one task each, and runs the tracer's bounce loop
 // (integrators/path_tracer.h) over each tile's samples in wavefronts. Pixels belong to exactly
-// one tile, so the image does not depend on the thread count.
+// one tile and their random numbers to the pixel, so the image does not depend on the thread
+// count.
 #include "integrators/path.h"
 #include "integrators/path_tracer.h"
 #include <tbb/enumerable_thread_specific.h>

@@ -1,5 +1,5 @@
 // What each scoring event of a path adds, written once. The wavefront tracer adds these to its
-// films as it goes (integrators/path.cpp, latent_stage.h), and the path-replay sweeps
+// films as it goes (integrators/path_tracer.cpp, latent_stage.h), and the path-replay sweeps
 // (autodiff/path_record.cpp) evaluate the same formulas on recorded paths with the current
 // coefficients: forward with the recorded throughput β, backward with β = 1 for the radiance R
 // that flows into earlier bounces. docs/transport.md (2)–(7), docs/path-replay.md (1)–(3).

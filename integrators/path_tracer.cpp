@@ -1,6 +1,6 @@
 // The bounce loop: each stage drains one queue and fills others, so the code reads like the
 // algorithm (integrators/path_tracer.h lists the stages). Short per-stage loops also let the CPU
-// overlap paths. Equations: docs/transport.md (1)–(4). Random dimensions: core/sampler.h.
+// overlap paths.
 #include "integrators/path_tracer.h"
 #include "core/envmap.h"
 #include "core/sampler.h"

@@ -1,8 +1,8 @@
 // The wavefront path tracer's stages for one tile, in the order the bounce loop runs them:
 // intersect → resolve hits (escaped | emitter hit → shade queue) → sample lights (NEE → shadow
 // queue) → sample BSDFs (+ Russian roulette → next ray queue) → trace shadow rays → swap ray
-// queues. Internal to integrators/: path.cpp drives it over tiles, path_tracer.cpp holds the
-// stages. Equations: docs/transport.md (1)–(4). Random dimensions: core/sampler.h.
+// queues. Internal to integrators/: path.cpp drives it over tiles. Equations: docs/transport.md
+// (1)–(4), the latent terms (5)–(7). Random dimensions: core/sampler.h.
 #pragma once
 #include "core/bsdf.h"
 #include "core/camera.h"
@@ -81,7 +81,9 @@ private:
 
     /// Stage 3: BSDF sampling (docs/transport.md (1)) and Russian roulette (4) → next rays.
     void sample_bsdfs(TileWorkspace<N>& ws, int cur, int depth) const;
-    /// Stage 4: shadow rays decide NEE contributions and, for latent first vertices, Ĩc's gate.
+
+    /// Stage 4: shadow rays decide NEE contributions and, for latent first vertices, Ĩc's gate
+    /// (those known unlit without a ray were gated in stage 2 by gate_unlit).
     void trace_shadow_rays(TileWorkspace<N>& ws, RenderStats& st) const;
 
     const Scene& m_scene;
