@@ -1,6 +1,7 @@
 // Internals of the Mitsuba 3 XML loader, shared by mitsuba_xml.cpp (scene structure: plugins,
-// ids, shapes, sensor) and mitsuba_xml_props.cpp (parameter substitution, property values,
-// transforms). Not part of the public API.
+// ids, shapes), mitsuba_xml_sensor.cpp (sensor, film, sampler, integrator) and
+// mitsuba_xml_props.cpp (parameter substitution, property values, transforms). Not part of the
+// public API.
 #pragma once
 #include "core/error.h"
 #include "core/props.h"
