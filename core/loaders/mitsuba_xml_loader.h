@@ -68,6 +68,8 @@ private:
     int add_material(const Props& m);
 
     // The camera and how it is rendered (mitsuba_xml_sensor.cpp).
+    /// A plugin element a scene may hold once (<integrator>, <sensor>), of the one `type` we read.
+    Plugin read_single(const pugi::xml_node& n, const std::string& tag, bool& seen, const std::string& type);
     void read_integrator(const pugi::xml_node& n);
     void read_sensor(const pugi::xml_node& n);  ///< with its <film> and <sampler>
     void read_film(const pugi::xml_node& n);

@@ -5,12 +5,17 @@
 
 namespace lpt::mitsuba_xml {
 
-void Loader::read_integrator(const pugi::xml_node& n) {
-    Plugin p = read_plugin(n, "integrator");
-    if (have_integrator) src.fail(n, "integrator", "only one <integrator> is supported");
-    have_integrator = true;
+Plugin Loader::read_single(const pugi::xml_node& n, const std::string& tag, bool& seen, const std::string& type) {
+    Plugin p = read_plugin(n, tag);
+    if (seen) src.fail(n, tag, "only one <" + tag + "> is supported");
+    seen = true;
     register_id(p.id, p.tag, p.line);
-    if (p.type != "path") unknown_plugin(p, "path");
+    if (p.type != type) unknown_plugin(p, type);
+    return p;
+}
+
+void Loader::read_integrator(const pugi::xml_node& n) {
+    Plugin p = read_single(n, "integrator", have_integrator, "path");
     allow_only(p, {"max_depth", "rr_depth", "hide_emitters"});
     for (const pugi::xml_node& c : p.children) unexpected_child(p, c);
     auto& s = scene.integrator;
@@ -22,11 +27,7 @@ void Loader::read_integrator(const pugi::xml_node& n) {
 }
 
 void Loader::read_sensor(const pugi::xml_node& n) {
-    Plugin p = read_plugin(n, "sensor");
-    if (have_sensor) src.fail(n, "sensor", "only one <sensor> is supported");
-    have_sensor = true;
-    register_id(p.id, p.tag, p.line);
-    if (p.type != "perspective") unknown_plugin(p, "perspective");
+    Plugin p = read_single(n, "sensor", have_sensor, "perspective");
     // focus_distance only matters to thinlens; a pinhole ignores it as Mitsuba's perspective does.
     allow_only(p, {"fov", "fov_axis", "near_clip", "far_clip", "to_world", "focus_distance"});
     Camera& cam = scene.camera;

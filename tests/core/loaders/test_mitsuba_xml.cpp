@@ -216,6 +216,20 @@ TEST(MitsubaXml, UnknownPluginNamesTypeAndLine) {
     expect_has(err, "'lanczos'");
 }
 
+// A scene holds one camera and one integrator; the second is an error at its own line.
+TEST(MitsubaXml, SecondSensorOrIntegratorNamesItsLine) {
+    const std::string integrator = "<integrator type=\"path\"/>";
+    std::string xml = scene_xml("\n" + integrator + "\n" + integrator + "\n" + kQuad);
+    std::string err = load_error("integrators.xml", xml);
+    expect_has(err, at_line("integrators.xml", line_of(xml, integrator) + 1));
+    expect_has(err, "only one <integrator> is supported");
+    xml = scene_xml(kQuad, kSensor + kSensor);
+    err = load_error("sensors.xml", xml);
+    const int second = line_of(xml, "<sensor") + int(std::count(kSensor.begin(), kSensor.end(), '\n'));
+    expect_has(err, at_line("sensors.xml", second));
+    expect_has(err, "only one <sensor> is supported");
+}
+
 TEST(MitsubaXml, UnsupportedFeaturesAreErrors) {
     auto check = [](const std::string& name, const std::string& xml, const std::string& needle,
                     const std::string& msg) {
