@@ -16,12 +16,16 @@ float triangle_area(const TriangleMesh& m, size_t t) {
 void Shape::prepare() {
     size_t n = mesh.triangle_count();
     m_cdf.resize(n);
-    m_face_normals.resize(n);
+    m_corners.assign(n, Corners{});
     for (size_t t = 0; t < n; ++t) {
         const uint32_t* idx = &mesh.indices[3 * t];
-        m_face_normals[t] = (mesh.positions[idx[1]] - mesh.positions[idx[0]])
-                                .cross(mesh.positions[idx[2]] - mesh.positions[idx[0]])
-                                .normalized();
+        Corners& c = m_corners[t];
+        for (int k = 0; k < 3; ++k) {
+            c.p[k] = mesh.positions[idx[k]];
+            if (!mesh.normals.empty()) c.n[k] = mesh.normals[idx[k]];
+            if (!mesh.uvs.empty()) c.uv[k] = mesh.uvs[idx[k]];
+        }
+        c.ng = (c.p[1] - c.p[0]).cross(c.p[2] - c.p[0]).normalized();
     }
     double sum = 0.0;  // double: 270k-triangle meshes lose float precision in the running sum
     for (size_t t = 0; t < n; ++t) {
@@ -37,39 +41,37 @@ PositionSample Shape::sample_position(const Eigen::Vector3f& u) const {
     const uint32_t t = pick_triangle(u.x());
     Vec2f b = sample_uniform_triangle(Vec2f(u.y(), u.z()));
     PositionSample ps;
-    const uint32_t* idx = &mesh.indices[3 * t];
-    const Vec3f &p0 = mesh.positions[idx[0]], &p1 = mesh.positions[idx[1]], &p2 = mesh.positions[idx[2]];
-    ps.p = (1.f - b.x() - b.y()) * p0 + b.x() * p1 + b.y() * p2;
+    const Corners& c = m_corners[t];
+    ps.p = (1.f - b.x() - b.y()) * c.p[0] + b.x() * c.p[1] + b.y() * c.p[2];
     ps.n = emission_normal(t, b.x(), b.y());
     ps.pdf_area = 1.f / m_area;
     return ps;
 }
 
 Vec3f Shape::emission_normal(uint32_t prim, float u, float v) const {
-    const uint32_t* idx = &mesh.indices[3 * prim];
+    const Corners& c = m_corners[prim];
     if (!flat()) {
-        Vec3f n = (1.f - u - v) * mesh.normals[idx[0]] + u * mesh.normals[idx[1]] + v * mesh.normals[idx[2]];
+        Vec3f n = (1.f - u - v) * c.n[0] + u * c.n[1] + v * c.n[2];
         float len = n.norm();
         if (len > 0.f) return n / len;
     }
-    return m_face_normals[prim];
+    return c.ng;
 }
 
 SurfaceInteraction Shape::interaction(uint32_t prim, float u, float v, float t) const {
     SurfaceInteraction si;
-    const uint32_t* idx = &mesh.indices[3 * prim];
-    const Vec3f &p0 = mesh.positions[idx[0]], &p1 = mesh.positions[idx[1]], &p2 = mesh.positions[idx[2]];
+    const Corners& c = m_corners[prim];
     float w = 1.f - u - v;
-    si.p = w * p0 + u * p1 + v * p2;
-    si.ng = m_face_normals[prim];
+    si.p = w * c.p[0] + u * c.p[1] + v * c.p[2];
+    si.ng = c.ng;
     Vec3f ns = si.ng;
     if (!face_normals && !mesh.normals.empty()) {
-        Vec3f n = w * mesh.normals[idx[0]] + u * mesh.normals[idx[1]] + v * mesh.normals[idx[2]];
+        Vec3f n = w * c.n[0] + u * c.n[1] + v * c.n[2];
         float len = n.norm();
         if (len > 0.f) ns = n / len;
     }
     si.sh = Frame(ns);
-    if (!mesh.uvs.empty()) si.uv = w * mesh.uvs[idx[0]] + u * mesh.uvs[idx[1]] + v * mesh.uvs[idx[2]];
+    if (!mesh.uvs.empty()) si.uv = w * c.uv[0] + u * c.uv[1] + v * c.uv[2];
     si.t = t;
     return si;
 }

@@ -5,6 +5,7 @@
 #include "core/geometry.h"
 #include "core/mesh.h"
 #include <algorithm>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -50,15 +51,23 @@ public:
     }
     /// Whether emission_normal is the face normal (no interpolated vertex normals).
     bool flat() const { return face_normals || mesh.normals.empty(); }
-    const Vec3f& face_normal(uint32_t prim) const { return m_face_normals[prim]; }
+    const Vec3f& face_normal(uint32_t prim) const { return m_corners[prim].ng; }
     /// Hit record from Embree's (primID, u, v, t): barycentrics p = (1-u-v) p0 + u p1 + v p2.
     SurfaceInteraction interaction(uint32_t prim, float u, float v, float t) const;
     /// Normal used for emission side and light pdfs at a hit (matches sample_position).
     Vec3f emission_normal(uint32_t prim, float u, float v) const;
 
 private:
+    /// One triangle's corners, copied out of the mesh by prepare(): a hit reads one record instead
+    /// of following indices to three positions and three normals, loads that each wait for the
+    /// last (docs/performance.md, session 46: −6 % render time on dining-room's 250k triangles).
+    struct Corners {
+        std::array<Vec3f, 3> p, n;  ///< n: the vertex normals, unset when flat()
+        std::array<Vec2f, 3> uv;    ///< unset without uvs
+        Vec3f ng;                   ///< unit face normal: hits and light samples reuse it
+    };
     std::vector<float> m_cdf;
-    std::vector<Vec3f> m_face_normals;  ///< unit, per triangle: hits and light samples reuse them
+    std::vector<Corners> m_corners;
     float m_area = 0.f;
 };
 
