@@ -34,7 +34,8 @@ public:
     int material = -1;          ///< index into Scene::materials
     int emitter = -1;           ///< index into Scene::emitters, -1 if not emissive
 
-    /// Computes area and the triangle distribution; call after the mesh changes.
+    /// Computes area, the triangle distribution and the per-triangle corner records that hits
+    /// read; call after the mesh changes (Scene::build does), or hits read the old mesh.
     void prepare();
     float area() const { return m_area; }
     /// Uniform by area: u.x() picks the triangle (then is reused), u.y()/u.z() the point.
@@ -60,7 +61,7 @@ public:
 private:
     /// One triangle's corners, copied out of the mesh by prepare(): a hit reads one record instead
     /// of following indices to three positions and three normals, loads that each wait for the
-    /// last (docs/performance.md, session 46: −6 % render time on dining-room's 250k triangles).
+    /// last (docs/performance.md, session 46: −6 to −10 % render time on dining-room's 286k triangles).
     struct Corners {
         std::array<Vec3f, 3> p, n;  ///< n: the vertex normals, unset when flat()
         std::array<Vec2f, 3> uv;    ///< unset without uvs
