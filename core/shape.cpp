@@ -16,7 +16,7 @@ float triangle_area(const TriangleMesh& m, size_t t) {
 void Shape::prepare() {
     size_t n = mesh.triangle_count();
     m_cdf.resize(n);
-    m_corners.assign(n, Corners{});
+    m_corners.resize(n);
     for (size_t t = 0; t < n; ++t) {
         const uint32_t* idx = &mesh.indices[3 * t];
         Corners& c = m_corners[t];
@@ -64,13 +64,7 @@ SurfaceInteraction Shape::interaction(uint32_t prim, float u, float v, float t) 
     float w = 1.f - u - v;
     si.p = w * c.p[0] + u * c.p[1] + v * c.p[2];
     si.ng = c.ng;
-    Vec3f ns = si.ng;
-    if (!face_normals && !mesh.normals.empty()) {
-        Vec3f n = w * c.n[0] + u * c.n[1] + v * c.n[2];
-        float len = n.norm();
-        if (len > 0.f) ns = n / len;
-    }
-    si.sh = Frame(ns);
+    si.sh = Frame(emission_normal(prim, u, v));  // the one normal: emitter hits read it from si.sh.n
     if (!mesh.uvs.empty()) si.uv = w * c.uv[0] + u * c.uv[1] + v * c.uv[2];
     si.t = t;
     return si;

@@ -151,7 +151,7 @@ void PathTracer<N>::resolve_hits(TileWorkspace<N>& ws, int cur, int depth) const
         SurfaceInteraction si = shape.interaction(rays.prim[i], rays.u[i], rays.v[i], rays.tfar[i]);
         const Vec3f wi_world = -rays.direction(i);
         if (shape.emitter >= 0) {
-            const Vec3f ne = shape.emission_normal(rays.prim[i], rays.u[i], rays.v[i]);
+            const Vec3f& ne = si.sh.n;  // = shape.emission_normal at the hit (Shape::interaction)
             const bool front = ne.dot(wi_world) > 0.f;
             // an emitter the training view never showed, in the look an edit gives it
             if (front && depth == 0 && m_latent && m_latent->camera_look(p, slot, shape_id)) continue;
