@@ -95,6 +95,10 @@ inline void add_refine_options(CLI::App* sc, pipeline::RefineJob& ra, const std:
     add_number(sc, "--" + pre + "dropout", ra.net.dropout, "dropout after each block", CLI::Range(0.0, 0.99));
     add_number(sc, "--" + pre + "emitter-cells", ra.net.emitter_cells,
                "also read each latent pixel's emitter coverage in N x N sub-cells (0 = no)", CLI::Range(0, 8));
+    add_number(sc, "--" + pre + "input-noise", ra.train.input_noise,
+               "std of Gaussian noise added, fresh each step, to the latent the refiner's body reads in training "
+               "(not to the latent its output is added to); 0 = none",
+               non_negative());
     add_number(sc, "--" + pre + "noise-views", ra.noise_views,
                "renders of the training view (independent samples) the refiner trains on; 1 = the fit's alone",
                positive());

@@ -118,6 +118,7 @@ nlohmann::json stage2_settings(const RefineJob& job) {
     if (job.net.emitter_cells) s["emitter_cells"] = job.net.emitter_cells;
     if (job.compensated_target) s["latent_target"] = "compensated";
     if (job.latent_target_block) s["latent_target_block"] = job.latent_target_block;
+    if (t.input_noise > 0.f) s["input_noise"] = t.input_noise;
     return s;
 }
 

@@ -104,6 +104,7 @@ nlohmann::json training_record(const RefineJob& job, const Refiner& refiner, con
         {"lpips_crop", job.train.lpips_crop},
         {"latent_target", job.compensated_target ? "compensated" : "encoded"}};
     if (job.latent_target_block) record["latent_target_block"] = job.latent_target_block;
+    if (job.train.input_noise > 0.f) record["input_noise"] = job.train.input_noise;
     if (refiner.config().arch != RefinerArch::Conv) record["arch"] = to_string(refiner.config().arch);
     if (refiner.config().terms) record["inputs"] = "terms";
     if (refiner.config().emitter_cells) record["emitter_cells"] = refiner.config().emitter_cells;
@@ -364,6 +365,7 @@ void validate(const RefineJob& job) {
     require(n.squash > 0 && std::isfinite(n.squash), "squash", "> 0", n.squash);
     require(n.dropout >= 0 && n.dropout <= 0.99f, "dropout", "in [0, 0.99]", n.dropout);
     require(job.noise_views > 0, "noise-views", "> 0", job.noise_views);
+    require(t.input_noise >= 0 && std::isfinite(t.input_noise), "input-noise", ">= 0", t.input_noise);
     require(n.emitter_cells >= 0 && n.emitter_cells <= 8, "emitter-cells", "in [0, 8]", n.emitter_cells);
     // transform_view would have to reorder the sub-cells inside each pixel; shift renders them anew
     require(n.emitter_cells == 0 || job.augment == RefinerAugment::None || job.augment == RefinerAugment::Shift,

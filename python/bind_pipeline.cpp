@@ -82,6 +82,7 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     else if (k == "window_stride") job.window_stride = value.cast<int>();
     else if (k == "dropout") n.dropout = value.cast<float>();
     else if (k == "noise_views") job.noise_views = value.cast<int>();
+    else if (k == "input_noise") t.input_noise = value.cast<float>();
     else if (k == "augment") job.augment = pipeline::parse_refiner_augment(value.cast<std::string>());
     else if (k == "latent_target")
         job.compensated_target = either(shown, value.cast<std::string>(), "compensated", "encoded");
@@ -235,7 +236,8 @@ void bind_pipeline(py::module_& m) {
     m.def("refine", &run_refine, py::arg("fitdir"), py::arg("resume") = false, py::arg("progress") = py::none(),
           py::arg("note") = py::none(),
           "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
-          "(iterations, lr, lr_decay, crop, patience, augment, noise_views, latent_target, norm, arch, inputs, "
+          "(iterations, lr, lr_decay, crop, patience, augment, noise_views, input_noise, latent_target, norm, arch, "
+          "inputs, "
           "inference, dropout, seed, emitters, ...).");
     m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("sampler") = "", py::arg("progress") = py::none(),

@@ -104,7 +104,13 @@ struct RefinerTrainOptions {
     float w_mse = 1.f, w_ssim = 0.f, w_lpips = 0.f;
     int crop = 32;        ///< latent pixels per side of the training crop; 0 = the whole view
     int lpips_crop = 16;  ///< latent pixels per side decoded for LPIPS (8× in RGB); 0 = no LPIPS
-    int patience = 500;   ///< early stopping on the smoothed loss; 0 = off
+    /// Standard deviation of Gaussian noise added to the rendered latent where the body reads it,
+    /// not to the latent the body's output is added to; drawn afresh for every step from (seed,
+    /// iteration). The body is trained to change its output little when its input changes a
+    /// little, so it cannot tie its output to one render's noise (docs/refiner.md "Input noise").
+    /// 0 = none: training as before the option.
+    float input_noise = 0.f;
+    int patience = 500;  ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
     uint64_t seed = 0;
     int checkpoint_every = 100;   ///< 0 = only at the end

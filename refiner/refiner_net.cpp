@@ -51,6 +51,12 @@ torch::Tensor forward_in_windows(RefinerNet& net, const torch::Tensor& x, int ti
     return sum / count;
 }
 
+/// x with `noise` added to its first `channels` channels (the latent); x itself when undefined.
+torch::Tensor with_latent_noise(const torch::Tensor& x, const torch::Tensor& noise, int64_t channels) {
+    if (!noise.defined()) return x;
+    return torch::cat({x.narrow(1, 0, channels) + noise, x.narrow(1, channels, x.size(1) - channels)}, 1);
+}
+
 }  // namespace
 
 RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
@@ -80,9 +86,9 @@ RefinerNetImpl::RefinerNetImpl(const RefinerConfig& config) : cfg(config) {
     drop = register_module("drop", torch::nn::Dropout(torch::nn::DropoutOptions(config.dropout)));
 }
 
-torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x) {
+torch::Tensor RefinerNetImpl::forward(const torch::Tensor& x, const torch::Tensor& body_noise) {
     auto norm = [](torch::nn::InstanceNorm2d& n, const torch::Tensor& t) { return n.is_empty() ? t : n(t); };
-    torch::Tensor h = torch::tanh(x / cfg.squash);
+    torch::Tensor h = torch::tanh(with_latent_noise(x, body_noise, cfg.latent_channels) / cfg.squash);
     if (!unet.is_empty()) return x.narrow(1, 0, cfg.latent_channels) + head(unet(h));
     h = drop(torch::relu(norm(n1, c1(h))));
     h = drop(torch::relu(norm(n2, c2(h))));

@@ -13,8 +13,9 @@ namespace lpt {
 struct RefinerNetImpl : torch::nn::Module {
     explicit RefinerNetImpl(const RefinerConfig& config);
     /// x: [N, refiner_input_channels, h, w] (latent, normal xyz, scaled distance[, Ĩe, Ĩa, Ĩc]) →
-    /// refined latent.
-    torch::Tensor forward(const torch::Tensor& x);
+    /// refined latent. body_noise ([N, latent_channels, h, w], training only) is added to the
+    /// latent the body reads, not to the one its output is added to (RefinerTrainOptions::input_noise).
+    torch::Tensor forward(const torch::Tensor& x, const torch::Tensor& body_noise = {});
 
     RefinerConfig cfg;
     torch::nn::Conv2d c1{nullptr}, c2{nullptr}, c3{nullptr}, head{nullptr};  ///< c1–c3: conv body only

@@ -1,7 +1,7 @@
 // Refiner training (stage 2): Adam on MSE + (1 − SSIM) of latents plus LPIPS of decoded crops,
 // on random crops of the training examples (the training view, and renders or augmented copies of
-// it) so an iteration stays cheap on a CPU. Example, crop positions and dropout masks are
-// functions of (seed, iteration), so a resumed run repeats the same iterations as an
+// it) so an iteration stays cheap on a CPU. Example, crop positions, dropout masks and input
+// noise are functions of (seed, iteration), so a resumed run repeats the same iterations as an
 // uninterrupted one.
 #include "autodiff/lr_schedule.h"
 #include "core/sampler.h"
@@ -174,6 +174,8 @@ int crop_side(int crop, int64_t size) { return crop > 0 ? std::min(crop, int(siz
 TrainingData training_data(const std::vector<RefinerExample>& examples, const RefinerConfig& cfg, const Vae* vae,
                            const Lpips* lpips, const RefinerTrainOptions& o) {
     if (examples.empty()) throw std::invalid_argument("refiner: no training view");
+    if (!(o.input_noise >= 0.f && std::isfinite(o.input_noise)))
+        throw std::invalid_argument("refiner: input noise must be >= 0, got " + std::to_string(o.input_noise));
     TrainingData d;
     const int c = cfg.latent_channels;
     int smallest = std::numeric_limits<int>::max();
@@ -203,7 +205,7 @@ TrainingData training_data(const std::vector<RefinerExample>& examples, const Re
 torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTrainOptions& o, int it,
                         RefinerRecord& r) {
     const uint64_t key = mix(o.seed ^ mix(uint64_t(it) + 1));
-    torch::manual_seed(key);                               // dropout masks
+    torch::manual_seed(key);                               // dropout masks, input noise
     const int view = pick(key + 5, int(d.xs.size()) - 1);  // 0 without drawing when there is one example
     const torch::Tensor& x_view = d.xs[size_t(view)];
     const int w = int(x_view.size(3)), h = int(x_view.size(2));
@@ -211,7 +213,10 @@ torch::Tensor crop_loss(RefinerNet& net, const TrainingData& d, const RefinerTra
     const int cx = pick(key + 1, w - crop_w), cy = pick(key + 2, h - crop_h);
     torch::Tensor x = x_view.narrow(2, cy, crop_h).narrow(3, cx, crop_w);
     torch::Tensor y = d.ys[size_t(view)].narrow(2, cy, crop_h).narrow(3, cx, crop_w);
-    torch::Tensor out = net->forward(x);
+    torch::Tensor noise;  // drawn after the seed: a resumed run draws the same
+    if (o.input_noise > 0.f)
+        noise = o.input_noise * torch::randn({1, int64_t(net->cfg.latent_channels), crop_h, crop_w});
+    torch::Tensor out = net->forward(x, noise);
     torch::Tensor mse = torch::mse_loss(out, y);
     torch::Tensor loss = o.w_mse * mse;
     r.iteration = it;
