@@ -237,8 +237,7 @@ void bind_pipeline(py::module_& m) {
           py::arg("note") = py::none(),
           "Stage 2 on a fit folder; returns metrics.json. Keyword options as `latentpt refine`'s with underscores "
           "(iterations, lr, lr_decay, crop, patience, augment, noise_views, input_noise, latent_target, norm, arch, "
-          "inputs, "
-          "inference, dropout, seed, emitters, ...).");
+          "inputs, inference, dropout, seed, emitters, ...).");
     m.def("render_edits", &render_edits, py::arg("fitdir"), py::arg("edits"), py::arg("out"), py::arg("spp") = 64,
           py::arg("seed") = 0, py::arg("reference") = false, py::arg("sampler") = "", py::arg("progress") = py::none(),
           py::arg("note") = py::none(),
