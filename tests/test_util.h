@@ -20,23 +20,29 @@ std::string shared_dir();
 /// n deterministic weights uniform in [-1, 1): a loss Σ W · Ĩ whose gradient d_image is W.
 std::vector<float> random_weights(size_t n, uint64_t seed);
 
-/// The message of the std::runtime_error `run` throws; "" when it returns normally.
-template <class Run>
-std::string runtime_error_of(Run&& run) {
+/// The message of the `Error` `run` throws; "" when it returns normally.
+template <class Error, class Run>
+std::string error_of(Run&& run) {
     try {
         std::forward<Run>(run)();
-    } catch (const std::runtime_error& e) {
+    } catch (const Error& e) {
         return e.what();
     }
     return "";
 }
 
-/// `run` must throw std::runtime_error naming each of `parts` (a bad input's file and field);
-/// `if_accepted` says what went wrong when it returns instead.
+/// The message of the std::runtime_error `run` throws; "" when it returns normally.
 template <class Run>
+std::string runtime_error_of(Run&& run) {
+    return error_of<std::runtime_error>(std::forward<Run>(run));
+}
+
+/// `run` must throw `Error` naming each of `parts` (a bad input's file and field, a bad option's
+/// name); `if_accepted` says what went wrong when it returns instead.
+template <class Error = std::runtime_error, class Run>
 void expect_error_naming(Run&& run, std::initializer_list<std::string> parts,
                          const std::string& if_accepted = "the bad input was accepted") {
-    const std::string what = runtime_error_of(std::forward<Run>(run));
+    const std::string what = error_of<Error>(std::forward<Run>(run));
     if (what.empty()) {
         ADD_FAILURE() << if_accepted;
         return;

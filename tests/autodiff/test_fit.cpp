@@ -139,12 +139,8 @@ TEST(Fit, RejectsNonFiniteOrMisshapenTargets) {
     LatentModel m(s, Parameterisation::Code, 1);
     std::vector<float> t(size_t(kRes) * kRes * kLatentChannels, 0.f);
     t[37] = std::nanf("");
-    try {
-        fit_latent(m, t, kRes, kRes, fit_options(1));
-        FAIL();
-    } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("channel 5"), std::string::npos) << e.what();
-    }
+    test::expect_error_naming<std::invalid_argument>([&] { fit_latent(m, t, kRes, kRes, fit_options(1)); },
+                                                     {"channel 5"}, "a NaN in the target was accepted");
     EXPECT_THROW(fit_latent(m, std::vector<float>(10), kRes, kRes, fit_options(1)), std::invalid_argument);
 }
 
