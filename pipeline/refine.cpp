@@ -366,6 +366,9 @@ void validate(const RefineJob& job) {
     require(n.dropout >= 0 && n.dropout <= 0.99f, "dropout", "in [0, 0.99]", n.dropout);
     require(job.noise_views > 0, "noise-views", "> 0", job.noise_views);
     require(t.input_noise >= 0 && std::isfinite(t.input_noise), "input-noise", ">= 0", t.input_noise);
+    // the terms carry the latent's render noise too; read clean, the body could still key on it
+    require(t.input_noise == 0 || !n.terms, "input-noise", "0 with --inputs terms (the terms are read without noise)",
+            t.input_noise);
     require(n.emitter_cells >= 0 && n.emitter_cells <= 8, "emitter-cells", "in [0, 8]", n.emitter_cells);
     // transform_view would have to reorder the sub-cells inside each pixel; shift renders them anew
     require(n.emitter_cells == 0 || job.augment == RefinerAugment::None || job.augment == RefinerAugment::Shift,

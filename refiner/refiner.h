@@ -108,7 +108,8 @@ struct RefinerTrainOptions {
     /// not to the latent the body's output is added to; drawn afresh for every step from (seed,
     /// iteration). The body is trained to change its output little when its input changes a
     /// little, so it cannot tie its output to one render's noise (docs/refiner.md "Input noise").
-    /// 0 = none: training as before the option.
+    /// 0 = none: training as before the option. Refused with RefinerConfig::terms, whose terms
+    /// carry the same render noise and would be read without it.
     float input_noise = 0.f;
     int patience = 500;  ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;

@@ -176,6 +176,9 @@ TrainingData training_data(const std::vector<RefinerExample>& examples, const Re
     if (examples.empty()) throw std::invalid_argument("refiner: no training view");
     if (!(o.input_noise >= 0.f && std::isfinite(o.input_noise)))
         throw std::invalid_argument("refiner: input noise must be >= 0, got " + std::to_string(o.input_noise));
+    // the terms carry the latent's render noise too; read clean, the body could still key on it
+    if (o.input_noise > 0.f && cfg.terms)
+        throw std::invalid_argument("refiner: input noise beside the transport terms as inputs (read without it)");
     TrainingData d;
     const int c = cfg.latent_channels;
     int smallest = std::numeric_limits<int>::max();

@@ -151,6 +151,7 @@ if [ -d "$shared/models/taesd3" ]; then
     expect_error "latent-target-block) 24 does not divide the 16x16 reference" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target compensated --latent-target-block 24
     expect_error "latent-target-block (fit --refiner-latent-target-block) must be 0 unless" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target-block 8
     expect_error "window-stride (fit --refiner-window-stride) must be at most --crop" "$bin" refine "$out/enc_comp" -q --iterations 2 --crop 8 --window-stride 9
+    expect_error "input-noise (fit --refiner-input-noise) must be 0 with --inputs terms" "$bin" refine "$out/enc_comp" -q --iterations 2 --input-noise 0.1 --inputs terms
     rm "$out/enc_comp/reference_rgb.exr"
     expect_error "reference_rgb.exr: refine --latent-target compensated" "$bin" refine "$out/enc_comp" -q --iterations 2 --latent-target compensated
     # Fits sharing a training reference through --reference-cache: traced once, the same target

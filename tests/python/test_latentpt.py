@@ -320,7 +320,8 @@ class OneProcessTest(unittest.TestCase):
                               ({"arch": "mlp"}, "arch"), ({"inputs": "rgb"}, "inputs"),
                               ({"latent_target": "decoded"}, "latent_target"),
                               ({"latent_target_block": 16}, "latent-target-block"),
-                              ({"window_stride": 0}, "window-stride")):
+                              ({"window_stride": 0}, "window-stride"),
+                              ({"input_noise": 0.1, "inputs": "terms"}, "input-noise")):
                 with self.assertRaises(ValueError) as e:
                     latentpt.refine(fit, note=lambda t: None, **bad)
                 self.assertIn(name, str(e.exception))

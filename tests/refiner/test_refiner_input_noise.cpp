@@ -1,7 +1,8 @@
 // Input noise in refiner training (RefinerTrainOptions::input_noise): the noise reaches the latent
-// the body reads and not the latent its output is added to, it lowers how much the body's output
-// follows a small change of its input while the refiner still learns its target, it replays on
-// resume, and a negative or non-finite value is refused.
+// the body reads and neither the latent its output is added to nor the AOVs, it lowers how much the
+// body's output follows a small change of its input while the refiner still learns its target, it
+// replays on resume, and a negative or non-finite value, or noise beside the transport terms as
+// inputs, is refused.
 #include "refiner/refiner.h"
 #include "refiner/refiner_problem.h"
 #include "test_util.h"
@@ -59,6 +60,35 @@ TEST(RefinerInputNoise, ReachesTheBodyNotTheLatentItIsAddedTo) {
     for (size_t i = 0; i < a.history.size(); ++i) EXPECT_EQ(a.history[i].mse, b.history[i].mse) << "step " << i;
 }
 
+// A residual only the AOVs tell: every pixel draws its own n_x and distance d in [1, 2], the
+// latent is the same everywhere, and the target is latent + 0.4 n_x on channel 0, + 0.8 − 0.6 d on
+// channel 5. Trained with noise (σ = 2) on the latent, the body must still learn it from the AOVs;
+// had the noise reached them, nothing would tell one pixel from another (a per-pixel draw, which
+// no spatial average recovers) and it could learn no more than the residual's mean.
+TEST(RefinerInputNoise, LeavesTheAovsClean) {
+    Problem p;
+    p.in.width = p.in.height = 16;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    for (int i = 0; i < 16 * 16; ++i) {
+        const float nx = u(rng), d = 1.5f + 0.5f * u(rng);
+        p.in.normal.insert(p.in.normal.end(), {nx, std::sqrt(1.f - nx * nx), 0.f});
+        p.in.distance.push_back(d);
+        for (int c = 0; c < kC; ++c) {
+            p.in.latent.push_back(0.3f * std::sin(float(c)));
+            p.target.push_back(p.in.latent.back() + (c == 0 ? 0.4f * nx : 0.f) + (c == 5 ? 0.8f - 0.6f * d : 0.f));
+        }
+    }
+    auto r = Refiner::create(small(), 5);
+    r->train(p.in, p.target, nullptr, nullptr, nullptr, mse_training(300, 12, 2.f));
+    const std::vector<float> refined = r->refine(p.in);
+    for (int channel : {0, 5}) {
+        const double before = channel_mse(p.in.latent, p.target, channel);
+        const double after = channel_mse(refined, p.target, channel);
+        EXPECT_LT(after, 0.2 * before) << "channel " << channel << ": unrefined " << before << ", refined " << after;
+    }
+}
+
 // The toy target depends on the AOVs only, so a body that ignores the latent loses nothing; trained
 // with noise on the latent it reads, it must follow a small change of the latent markedly less
 // than the same body trained without, and still learn most of the target.
@@ -92,12 +122,22 @@ TEST(RefinerInputNoise, ReplaysOnResumeAndRefusesBadValues) {
     EXPECT_EQ(resumed->refine(p.in), full->refine(p.in));
 
     for (float bad : {-0.1f, std::numeric_limits<float>::quiet_NaN()}) {
-        RefinerTrainOptions b = mse_training(2, 11, bad);
-        try {
-            Refiner::create(small(), 5)->train(p.in, p.target, nullptr, nullptr, nullptr, b);
-            ADD_FAILURE() << "input noise " << bad << " accepted";
-        } catch (const std::invalid_argument& e) {
-            EXPECT_NE(std::string(e.what()).find("input noise"), std::string::npos) << e.what();
-        }
+        const RefinerTrainOptions b = mse_training(2, 11, bad);
+        test::expect_error_naming<std::invalid_argument>(
+            [&] { Refiner::create(small(), 5)->train(p.in, p.target, nullptr, nullptr, nullptr, b); }, {"input noise"},
+            "input noise " + std::to_string(bad) + " accepted");
     }
+}
+
+// The transport terms carry the latent's render noise; the noise is drawn for the latent alone, so
+// the pair is refused (by name) rather than trained with the terms read clean.
+TEST(RefinerInputNoise, RefusedBesideTheTransportTerms) {
+    Problem p = make_problem(12, 12);
+    p.in.terms.assign(p.in.latent.size() * 3, 0.25f);
+    RefinerConfig cfg = small();
+    cfg.terms = true;
+    Refiner::create(cfg, 5)->train(p.in, p.target, nullptr, nullptr, nullptr, mse_training(2, 11, 0.f));
+    test::expect_error_naming<std::invalid_argument>(
+        [&] { Refiner::create(cfg, 5)->train(p.in, p.target, nullptr, nullptr, nullptr, mse_training(2, 11, 0.1f)); },
+        {"input noise", "transport terms"}, "input noise beside the terms accepted");
 }
