@@ -146,8 +146,7 @@ void LightSampler::sample_batch(const std::vector<Emitter>& emitters, const std:
         if (b.scalar[k]) continue;
         const Shape& s = shapes[e.shape];
         const uint32_t t = s.pick_triangle(u_tri);
-        const uint32_t* idx = &s.mesh.indices[3 * t];
-        const Vec3f &p0 = s.mesh.positions[idx[0]], &p1 = s.mesh.positions[idx[1]], &p2 = s.mesh.positions[idx[2]];
+        const auto& [p0, p1, p2] = s.corner_positions(t);
         const Vec3f& nf = s.face_normal(t);
         b.ax[k] = p0.x();
         b.ay[k] = p0.y();

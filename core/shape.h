@@ -53,6 +53,8 @@ public:
     /// Whether emission_normal is the face normal (no interpolated vertex normals).
     bool flat() const { return face_normals || mesh.normals.empty(); }
     const Vec3f& face_normal(uint32_t prim) const { return m_corners[prim].ng; }
+    /// The triangle's three corner positions, from the record a hit reads (no index lookups).
+    const std::array<Vec3f, 3>& corner_positions(uint32_t prim) const { return m_corners[prim].p; }
     /// Hit record from Embree's (primID, u, v, t): barycentrics p = (1-u-v) p0 + u p1 + v p2.
     SurfaceInteraction interaction(uint32_t prim, float u, float v, float t) const;
     /// Normal used for emission side and light pdfs at a hit (matches sample_position).

@@ -214,7 +214,9 @@ TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
             nothing += missed;
             for (int k = 0; k < 16; ++k) {
                 const size_t i = p * 16 + k;
-                if (missed) EXPECT_NEAR(e0[i], env[k], 1e-6f) << "before: the environment, seen directly";
+                if (missed) {
+                    EXPECT_NEAR(e0[i], env[k], 1e-6f) << "before: the environment, seen directly";
+                }
                 if (missed || plane_look) {
                     EXPECT_NEAR(a1[i], (missed ? v_nothing : v_plane)[k], 1e-6f) << p;
                     EXPECT_EQ(e1[i], 0.f) << p;

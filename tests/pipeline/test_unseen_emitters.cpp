@@ -107,8 +107,12 @@ TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
     for (size_t p = 0; p < cover.size(); ++p)
         for (int k = 0; k < 16; ++k) {
             const float got = f.latent[p * 16 + k];
-            if (cover[p] == 1.f) EXPECT_NEAR(got, look[k], 1e-4f) << p;  // through the tone curve and back
-            if (cover[p] == 0.f) EXPECT_EQ(got, raw[p * 16 + k]) << p;
+            if (cover[p] == 1.f) {
+                EXPECT_NEAR(got, look[k], 1e-4f) << p;  // through the tone curve and back
+            }
+            if (cover[p] == 0.f) {
+                EXPECT_EQ(got, raw[p * 16 + k]) << p;
+            }
             whole += k == 0 && cover[p] == 1.f;
             unseen_pixels += k == 0 && cover[p] == 0.f;
         }
