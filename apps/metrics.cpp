@@ -2,7 +2,9 @@
 // PSNR and SSIM between two latent EXRs (docs/metrics.md).
 //   * PNG/JPEG (and other non-float formats): display values in [0, 1] as read.
 //   * EXR/HDR with 3 or 4 channels: linear RGB, turned into display values as fit's
-//     --ref-tone clip does (clip to [0, 1], then x^(1/2.2)). A 4th (alpha) channel is ignored.
+//     --ref-tone clip does (clip to [0, 1], then x^(1/2.2)), unless the header marks them as
+//     display values already (references, decoded latents: only clipped to [0, 1], as the edit
+//     and refine scores clip decoded RGB). A 4th (alpha) channel is ignored.
 //   * EXR with 16 channels: TAESD3 latents, compared as they are over the data range 6
 //     ([-3, 3], the decoder's soft-clamp range); no LPIPS (it is an RGB metric).
 // `latentpt metrics --pairs FILE` scores many pairs in one process (one JSON line each): loading
@@ -67,15 +69,19 @@ Loaded load(const std::string& path) {
         throw std::runtime_error(path + ": " + std::to_string(img.channels) +
                                  " channels; metrics compares RGB(A) images (3 or 4 channels) or " +
                                  std::to_string(kLatentChannels) + "-channel latent EXRs");
-    const bool linear = is_float_format(path);
+    const bool linear = is_float_format(path) && !img.display;
     l.channels = 3;
-    l.kind = linear ? "linear RGB -> display (clip, gamma 1/2.2)" : "display RGB";
+    l.kind = linear        ? "linear RGB -> display (clip, gamma 1/2.2)"
+             : img.display ? "display RGB (EXR marked so), clipped to [0, 1]"
+                           : "display RGB";
     if (img.channels == 4) l.kind += ", alpha ignored";
     l.data.resize(size_t(img.width) * img.height * 3);
     for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
         for (int c = 0; c < 3; ++c) {
             float v = img.data[i * img.channels + c];
             if (linear) v = std::pow(std::clamp(v, 0.f, 1.f), 1.f / 2.2f);  // fit --ref-tone clip
+            // a decoded latent overshoots [0, 1]; the edit and refine scores clamp it so too
+            if (img.display) v = std::clamp(v, 0.f, 1.f);
             l.data[i * 3 + c] = v;
         }
     return l;

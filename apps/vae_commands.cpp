@@ -2,6 +2,7 @@
 // vae/; this file is part of the torch plugin, apps/torch_commands.h).
 #include "apps/commands.h"
 #include "core/image_io.h"
+#include "pipeline/reference.h"
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
 #include <filesystem>
@@ -27,11 +28,13 @@ std::vector<float> rgb_of(const Image& img, const std::string& path) {
 int run_encode(const VaeArgs& a) {
     Image img = read_image(a.input);
     auto vae = pipeline::open_vae(a.vae);
-    // Files hold display values in [0, 1] (PNG/JPEG) or linear radiance (EXR): TAESD wants the former.
+    // Files hold display values in [0, 1] (PNG/JPEG, EXRs marked so) or linear radiance (other
+    // EXRs): TAESD wants the former, mapped as fit maps its references, so that a render's
+    // encoding here is the latent fit --encode would target.
     std::vector<float> rgb = rgb_of(img, a.input);
     std::string ext = fs::path(a.input).extension().string();
-    if (ext == ".exr" || ext == ".hdr")
-        for (float& v : rgb) v = linear_to_srgb(v);
+    if ((ext == ".exr" || ext == ".hdr") && !img.display)
+        for (float& v : rgb) v = pipeline::display_value(v, "clip");
     std::vector<float> latent = vae->encode(rgb, img.width, img.height);
     const int c = vae->convention().channels, w = img.width / vae->convention().downsample,
               h = img.height / vae->convention().downsample;
@@ -49,7 +52,7 @@ int run_decode(const VaeArgs& a) {
     std::vector<float> rgb = vae->decode(lat.data, lat.width, lat.height);
     // Decoded values are display-referred (about [0, 1]): EXR keeps them unclamped, PNG as they are.
     const int f = vae->convention().downsample;
-    Image out{lat.width * f, lat.height * f, 3, rgb, {"R", "G", "B"}};
+    Image out{lat.width * f, lat.height * f, 3, rgb, {"R", "G", "B"}, true};
     if (fs::path(a.out).extension() == ".exr") write_exr(a.out, out);
     else write_png_display(a.out, out);
     if (!a.quiet) std::cerr << "wrote " << a.out << " (" << out.width << "x" << out.height << ")\n";

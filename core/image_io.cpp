@@ -5,6 +5,7 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <png.h>
 #include <algorithm>
@@ -94,6 +95,7 @@ void write_exr(const std::string& path, const Image& img) {
     // exactly the files of one job.
     Imf::Header header(img.width, img.height);
     header.compression() = Imf::ZIP_COMPRESSION;
+    if (img.display) header.insert(kDisplayValuesAttribute, Imf::StringAttribute(kDisplayValues));
     Imf::FrameBuffer frame;
     const size_t x_stride = sizeof(float) * img.channels, y_stride = x_stride * img.width;
     for (int c = 0; c < img.channels; ++c) {
@@ -149,6 +151,7 @@ Image read_image(const std::string& path) {
     img.height = info.height;
     img.channels = info.channels;
     img.channel_names = info.channel_names;
+    img.display = info.display_values;
     // The header's size is checked before anything is allocated from it.
     try {
         check_image_fits(img.width, img.height, size_t(std::max(img.channels, 1)));

@@ -12,6 +12,11 @@ struct Image {
     int width = 0, height = 0, channels = 0;
     std::vector<float> data;  ///< interleaved, row-major from the top-left
     std::vector<std::string> channel_names;
+    /// Display values (already through a display mapping, about [0, 1]) rather than linear
+    /// radiance: a reference after fit's tone, a decoded latent. write_exr records it in the
+    /// header (core/image_reader.h kDisplayValuesAttribute) and read_image reads it back, so that
+    /// readers which map an EXR's linear values to display ones (metrics, encode) leave these be.
+    bool display = false;
 };
 
 /// 32-bit float EXR, ZIP-compressed, no time stamp; `path` must end in .exr. Channel names

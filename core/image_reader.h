@@ -10,12 +10,19 @@
 
 namespace lpt {
 
+/// The EXR header attribute whose string value kDisplayValues marks the values as display values
+/// (already display-mapped, about [0, 1]); files without it hold linear values.
+inline constexpr const char* kDisplayValuesAttribute = "latentpt:values";
+inline constexpr const char* kDisplayValues = "display";
+
 /// An image file's header, as read before any pixel is decoded.
 struct ImageFileInfo {
     int width = 0, height = 0, depth = 1, channels = 0;
     std::vector<std::string> channel_names;
     bool is_float = false;  ///< float, half or double samples
     bool is_uint8 = false;  ///< 8-bit samples
+    /// The header marks the values as display values (kDisplayValuesAttribute).
+    bool display_values = false;
 };
 
 class ImageFileReader {

@@ -79,7 +79,7 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
             encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
         fs::create_directories(fs::path(cache_stem).parent_path());
         write_latent_file(latent);
-        write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}});
+        write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}, true});
         return latent;
     }
     display_rgb = read_fit_image(rgb_file, 3, width, height).data;

@@ -132,6 +132,18 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" fit "$scene" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q $small_refiner --out "$out/enc"
     for f in reference.png reference_rgb.exr target.exr target_decoded.png decoded.png decoded_refined.png metrics.json; do check test -s "$out/enc/$f"; done
     check grep -q vae_roundtrip "$out/enc/metrics.json"
+    # EXRs of display values (the fit's reference, a decoded latent) say so in their header, and
+    # metrics and encode read them as such: against their PNGs they differ by 8-bit rounding
+    # only (read as linear, they would be display-mapped twice). A render's linear EXR encodes
+    # as fit maps its reference: the render fit traced (its seed 0x5eed = 24301) encodes to
+    # fit's target.exr exactly.
+    check sh -c "'$bin' metrics '$out/enc/reference_rgb.exr' '$out/enc/reference.png' | grep -q 'display RGB (EXR marked so)'"
+    check sh -c "'$bin' metrics --json '$out/enc/reference_rgb.exr' '$out/enc/reference.png' | python3 -c 'import json,sys; assert json.load(sys.stdin)[\"mse\"] < 4e-6'"
+    "$bin" decode "$out/enc/target.exr" -q --out "$out/enc_dec.exr"
+    check sh -c "'$bin' metrics --json '$out/enc_dec.exr' '$out/enc/target_decoded.png' | python3 -c 'import json,sys; assert json.load(sys.stdin)[\"mse\"] < 4e-6'"
+    "$bin" render "$scene" --res 16x16 --spp 4 --seed 24301 -q --out "$out/enc_ref.exr"
+    "$bin" encode "$out/enc_ref.exr" -q --out "$out/enc_ref_latent.exr"
+    check oiiotool "$out/enc_ref_latent.exr" "$out/enc/target.exr" --fail 1e-6 --diff
     # Augmented views from the fit's own reference: trained, recorded; a bad name is refused.
     cp -r "$out/enc" "$out/enc_aug"
     "$bin" refine "$out/enc_aug" --iterations 6 --expansion 1 -q --augment dihedral

@@ -1,5 +1,6 @@
 // Image files: multi-channel latent EXRs round-trip in channel order (EXR sorts channels by
-// name), also when another tool named them C0..C15 without padding; writes are atomic.
+// name), also when another tool named them C0..C15 without padding; writes are atomic; the mark
+// of display values round-trips.
 #include "core/image_io.h"
 #include "test_util.h"
 #include <gtest/gtest.h>
@@ -23,6 +24,21 @@ TEST(ImageIo, SixteenChannelExrKeepsChannelOrder) {
     // No temp files left behind by the atomic writes.
     for (const auto& e : std::filesystem::directory_iterator(dir))
         EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+// An EXR of display values (a reference after fit's tone, a decoded latent) says so in its header
+// and reads back marked; one of linear values reads back unmarked, with the same pixels.
+TEST(ImageIo, DisplayValuesMarkRoundTrips) {
+    const std::string dir = std::filesystem::path(test::write_temp_file("io-display", "")).parent_path().string();
+    Image img{2, 2, 3, {0.f, 0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f, 1.f, 1.1f}, {"R", "G", "B"}};
+    for (bool display : {true, false}) {
+        img.display = display;
+        const std::string path = dir + (display ? "/display.exr" : "/linear.exr");
+        write_exr(path, img);
+        const Image back = read_image(path);
+        EXPECT_EQ(back.display, display);
+        EXPECT_EQ(back.data, img.data);
+    }
 }
 
 namespace {
