@@ -257,9 +257,10 @@ struct Cli {
     }
 
     void add_vae_commands(CLI::App& app) {
-        encode = app.add_subcommand("encode",
-                                    "RGB image (PNG/JPEG display values, or linear EXR) -> 16-channel latent EXR "
-                                    "(TAESD3 or a TorchScript VAE)");
+        encode =
+            app.add_subcommand("encode",
+                               "RGB image (PNG/JPEG display values, linear EXR, or an EXR marked as display values) "
+                               "-> 16-channel latent EXR (TAESD3 or a TorchScript VAE)");
         decode = app.add_subcommand("decode", "latent EXR -> RGB image (PNG, or EXR unclamped)");
         viz = app.add_subcommand("viz", "latent EXR -> PNG of its channels (green positive, red negative)");
         for (auto* sc : {encode, decode, viz}) {
@@ -271,9 +272,10 @@ struct Cli {
     }
 
     void add_metrics(CLI::App& app) {
-        metrics = app.add_subcommand("metrics",
-                                     "MSE, PSNR, SSIM and LPIPS between two images (PNG display values or linear EXR), "
-                                     "or MSE, PSNR and SSIM between two 16-channel latent EXRs");
+        metrics = app.add_subcommand(
+            "metrics",
+            "MSE, PSNR, SSIM and LPIPS between two images (PNG display values, linear EXR, or an "
+            "EXR marked as display values), or MSE, PSNR and SSIM between two 16-channel latent EXRs");
         auto* a = metrics->add_option("a", m.a, "first image or latent EXR")->check(CLI::ExistingFile);
         auto* b =
             metrics->add_option("b", m.b, "second image or latent EXR, same size and kind")->check(CLI::ExistingFile);

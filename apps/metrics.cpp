@@ -71,9 +71,10 @@ Loaded load(const std::string& path) {
                                  std::to_string(kLatentChannels) + "-channel latent EXRs");
     const bool linear = is_float_format(path) && !img.display;
     l.channels = 3;
-    l.kind = linear        ? "linear RGB -> display (clip, gamma 1/2.2)"
-             : img.display ? "display RGB (EXR marked so), clipped to [0, 1]"
-                           : "display RGB";
+    const bool marked = is_float_format(path) && img.display;
+    l.kind = linear   ? "linear RGB -> display (clip, gamma 1/2.2)"
+             : marked ? "display RGB (EXR marked so), clipped to [0, 1]"
+                      : "display RGB";
     if (img.channels == 4) l.kind += ", alpha ignored";
     l.data.resize(size_t(img.width) * img.height * 3);
     for (size_t i = 0; i < size_t(img.width) * img.height; ++i)

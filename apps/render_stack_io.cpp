@@ -11,6 +11,10 @@ std::vector<float> load_rgb(const std::string& path, int factor, int& width, int
     if (img.channels < 3)
         throw std::runtime_error(path + ": expected an RGB image, found " + std::to_string(img.channels) +
                                  " channel(s)");
+    if (img.display)
+        throw std::runtime_error(path +
+                                 ": holds display values (a reference after fit's tone, or a decoded "
+                                 "latent); comparing renders needs linear radiance");
     if (img.width % factor || img.height % factor)
         throw std::runtime_error(path + ": " + std::to_string(img.width) + "x" + std::to_string(img.height) +
                                  " is not a multiple of the downsampling factor " + std::to_string(factor));

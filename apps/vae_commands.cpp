@@ -5,6 +5,8 @@
 #include "pipeline/reference.h"
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <iostream>
 
@@ -33,8 +35,10 @@ int run_encode(const VaeArgs& a) {
     // encoding here is the latent fit --encode would target.
     std::vector<float> rgb = rgb_of(img, a.input);
     std::string ext = fs::path(a.input).extension().string();
-    if ((ext == ".exr" || ext == ".hdr") && !img.display)
-        for (float& v : rgb) v = pipeline::display_value(v, "clip");
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const bool linear = (ext == ".exr" || ext == ".hdr") && !img.display;
+    // a decoded EXR overshoots [0, 1]; as a PNG it would have been clipped
+    for (float& v : rgb) v = linear ? pipeline::display_value(v, "clip") : std::clamp(v, 0.f, 1.f);
     std::vector<float> latent = vae->encode(rgb, img.width, img.height);
     const int c = vae->convention().channels, w = img.width / vae->convention().downsample,
               h = img.height / vae->convention().downsample;

@@ -144,6 +144,7 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" render "$scene" --res 16x16 --spp 4 --seed 24301 -q --out "$out/enc_ref.exr"
     "$bin" encode "$out/enc_ref.exr" -q --out "$out/enc_ref_latent.exr"
     check oiiotool "$out/enc_ref_latent.exr" "$out/enc/target.exr" --fail 1e-6 --diff
+    expect_error "holds display values" "$bin" compare --test "$out/enc_ref.exr" --ref "$out/enc/reference_rgb.exr"
     # Augmented views from the fit's own reference: trained, recorded; a bad name is refused.
     cp -r "$out/enc" "$out/enc_aug"
     "$bin" refine "$out/enc_aug" --iterations 6 --expansion 1 -q --augment dihedral
