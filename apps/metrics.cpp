@@ -11,10 +11,9 @@
 // libtorch and LPIPS costs ~1 s, more than scoring a 1024² pair (scripts/reference_noise.py).
 #include "apps/commands.h"
 #include "core/image_io.h"
+#include "pipeline/reference.h"
 #include "vae/lpips.h"
 #include "vae/ssim.h"
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -47,18 +46,12 @@ struct Loaded {
     std::vector<float> data;
 };
 
-bool is_float_format(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".exr" || ext == ".hdr";
-}
-
 Loaded load(const std::string& path) {
     Image img = read_image(path);
     Loaded l;
     l.width = img.width;
     l.height = img.height;
-    if (img.channels == kLatentChannels && is_float_format(path)) {
+    if (img.channels == kLatentChannels && pipeline::float_image_path(path)) {
         l.latent = true;
         l.channels = img.channels;
         l.kind = "latent (16 channels)";
@@ -69,22 +62,20 @@ Loaded load(const std::string& path) {
         throw std::runtime_error(path + ": " + std::to_string(img.channels) +
                                  " channels; metrics compares RGB(A) images (3 or 4 channels) or " +
                                  std::to_string(kLatentChannels) + "-channel latent EXRs");
-    const bool linear = is_float_format(path) && !img.display;
     l.channels = 3;
-    const bool marked = is_float_format(path) && img.display;
-    l.kind = linear   ? "linear RGB -> display (clip, gamma 1/2.2)"
-             : marked ? "display RGB (EXR marked so), clipped to [0, 1]"
-                      : "display RGB";
+    switch (pipeline::rgb_values_of(img, path)) {
+        case pipeline::RgbValues::Linear:
+            l.kind = "linear RGB -> display (clip, gamma 1/2.2)";
+            break;
+        case pipeline::RgbValues::MarkedDisplay:
+            l.kind = "display RGB (EXR marked so), clipped to [0, 1]";
+            break;
+        case pipeline::RgbValues::Display:
+            l.kind = "display RGB";
+            break;
+    }
     if (img.channels == 4) l.kind += ", alpha ignored";
-    l.data.resize(size_t(img.width) * img.height * 3);
-    for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
-        for (int c = 0; c < 3; ++c) {
-            float v = img.data[i * img.channels + c];
-            if (linear) v = std::pow(std::clamp(v, 0.f, 1.f), 1.f / 2.2f);  // fit --ref-tone clip
-            // a decoded latent overshoots [0, 1]; the edit and refine scores clamp it so too
-            if (img.display) v = std::clamp(v, 0.f, 1.f);
-            l.data[i * 3 + c] = v;
-        }
+    l.data = pipeline::display_rgb(img, path);
     return l;
 }
 

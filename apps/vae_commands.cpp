@@ -5,8 +5,6 @@
 #include "pipeline/reference.h"
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 #include <iostream>
 
@@ -16,13 +14,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<float> rgb_of(const Image& img, const std::string& path) {
+void require_rgb(const Image& img, const std::string& path) {
     if (img.channels < 3)
         throw std::runtime_error(path + ": needs 3 channels (RGB), has " + std::to_string(img.channels));
-    std::vector<float> rgb(size_t(img.width) * img.height * 3);
-    for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
-        for (int c = 0; c < 3; ++c) rgb[i * 3 + c] = img.data[i * img.channels + c];
-    return rgb;
 }
 
 }  // namespace
@@ -30,15 +24,10 @@ std::vector<float> rgb_of(const Image& img, const std::string& path) {
 int run_encode(const VaeArgs& a) {
     Image img = read_image(a.input);
     auto vae = pipeline::open_vae(a.vae);
-    // Files hold display values in [0, 1] (PNG/JPEG, EXRs marked so) or linear radiance (other
-    // EXRs): TAESD wants the former, mapped as fit maps its references, so that a render's
-    // encoding here is the latent fit --encode would target.
-    std::vector<float> rgb = rgb_of(img, a.input);
-    std::string ext = fs::path(a.input).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    const bool linear = (ext == ".exr" || ext == ".hdr") && !img.display;
-    // a decoded EXR overshoots [0, 1]; as a PNG it would have been clipped
-    for (float& v : rgb) v = linear ? pipeline::display_value(v, "clip") : std::clamp(v, 0.f, 1.f);
+    // TAESD wants display values; a linear EXR is mapped as fit maps its references, so that a
+    // render's encoding here is the latent fit --encode would target.
+    require_rgb(img, a.input);
+    const std::vector<float> rgb = pipeline::display_rgb(img, a.input);
     std::vector<float> latent = vae->encode(rgb, img.width, img.height);
     const int c = vae->convention().channels, w = img.width / vae->convention().downsample,
               h = img.height / vae->convention().downsample;

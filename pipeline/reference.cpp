@@ -6,6 +6,7 @@
 #include "integrators/path.h"
 #include "vae/vae.h"
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -16,6 +17,30 @@ namespace lpt::pipeline {
 float display_value(float v, const std::string& tone) {
     v = tone == "reinhard" ? std::abs(v) / (1.f + std::abs(v)) : std::clamp(v, 0.f, 1.f);
     return std::pow(v, 1.f / 2.2f);
+}
+
+bool float_image_path(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".exr" || ext == ".hdr";
+}
+
+RgbValues rgb_values_of(const Image& img, const std::string& path) {
+    if (!float_image_path(path)) return RgbValues::Display;
+    return img.display ? RgbValues::MarkedDisplay : RgbValues::Linear;
+}
+
+std::vector<float> display_rgb(const Image& img, const std::string& path) {
+    const RgbValues values = rgb_values_of(img, path);
+    std::vector<float> rgb(size_t(img.width) * img.height * 3);
+    for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const float v = img.data[i * img.channels + c];
+            rgb[i * 3 + c] = values == RgbValues::Linear          ? display_value(v, "clip")
+                             : values == RgbValues::MarkedDisplay ? std::clamp(v, 0.f, 1.f)
+                                                                  : v;
+        }
+    return rgb;
 }
 
 std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,

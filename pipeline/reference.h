@@ -8,6 +8,7 @@
 namespace lpt {
 class Scene;
 class Vae;
+struct Image;
 }  // namespace lpt
 
 namespace lpt::pipeline {
@@ -15,6 +16,17 @@ namespace lpt::pipeline {
 /// The paper's display mapping for references: clip to [0, 1] (or |x|/(1+|x|) for "reinhard"),
 /// then x^(1/2.2).
 float display_value(float v, const std::string& tone);
+
+/// Whether `path` names a float image format by its extension, any case (.exr, .hdr).
+bool float_image_path(const std::string& path);
+/// How an RGB file's values are read as display values (metrics, encode): PNG/JPEG as read; an
+/// EXR/HDR marked as display values (Image::display: references, decoded latents) clipped to
+/// [0, 1], as the edit scores clip decoded RGB; other EXR/HDR taken for linear radiance and mapped
+/// with display_value(v, "clip"), as fit maps its references.
+enum class RgbValues { Display, MarkedDisplay, Linear };
+RgbValues rgb_values_of(const Image& img, const std::string& path);
+/// The first three channels of `img` (at least three) as display values, read as rgb_values_of says.
+std::vector<float> display_rgb(const Image& img, const std::string& path);
 
 /// The seed of every reference unless told otherwise: fits, edit sequences and the bench share it.
 constexpr uint64_t kReferenceSeed = 0x5eed;
