@@ -24,7 +24,18 @@ TABLE1_NOTE = ("Mean over the evaluated frames; the paper's values (in brackets)
                "view's reference encoded and decoded by TAESD3, the floor no latent can beat (one value per scene, "
                "repeated on its rows).")
 TABLE1_TARGETS = ("each column below the one before it in both metrics; the +refiner column at most the paper's "
-                  "value where the round trip is below it, else at most 1.5× the round trip.")
+                  "value where the round trip is below it, else at most 1.5× the round trip. The issue sets them "
+                  "for cbox-specular at 128² latents; they are checked here on every scene.")
+ISSUE_SCENE = "cbox-specular"  # the scene issue 16's targets are stated for
+
+
+def misses_line(misses, lead):
+    """`lead` and how many targets missed, with the issue's own scene's share when others are in the table."""
+    if not misses:
+        return lead + " All met."
+    own = sum(1 for x in misses if x.startswith(ISSUE_SCENE + "/"))
+    scope = f" ({own} on {ISSUE_SCENE}, the scene the issue sets them for)" if own < len(misses) else ""
+    return f"{lead} {len(misses)} missed{scope}:"
 
 
 def table1_rows(c, summary):
@@ -86,8 +97,8 @@ def table1_html(c, summary, title):
         return f'<span class="miss">{v}</span>' if (j, m) in r["missed"] else v
 
     h = [f"<h2>{html.escape(title)}</h2>", "<p>LPIPS / MSE×100, ours <span class='paper'>(paper's)</span>; "
-         f"<span class='miss'>red</span>: a target missed ({len(misses)}). {html.escape(TABLE1_NOTE)}</p>",
-         f"<p>Targets (issue 16): {html.escape(TABLE1_TARGETS)}</p>",
+         f"<span class='miss'>red</span>: a target missed. {html.escape(TABLE1_NOTE)}</p>",
+         f"<p>{html.escape(misses_line(misses, 'Targets (issue 16): ' + TABLE1_TARGETS).rstrip(':'))}</p>",
          "<table class='t1'><tr><th>scene</th><th>edit</th>" + "".join(f"<th>{html.escape(lab)}</th>" for _, lab in TABLE1_COLUMNS) +
          "<th>VAE round trip</th></tr>"]
     for r in rows:

@@ -179,6 +179,18 @@ class Table1(unittest.TestCase):
         self.assertEqual(h.count('<span class="miss">0.070</span>'), 2)
         self.assertIn("(0.502 / 2.264)", h)
 
+    def test_the_misses_line_counts_the_issues_own_scene(self):
+        c = X.settings(paper=True, scenes=["cbox-specular", "veach-bidir"])
+        bad = [(0.5, 2.0), (0.2, 0.3), (0.25, 0.2), (0.01, 0.02)]  # +Ĩc LPIPS on every edit of each scene
+        summary = dict(self.summary(bad, (0.005, 0.01)))
+        summary["veach-bidir"] = summary["cbox-specular"]
+        _, misses = X.table1(c, summary)
+        self.assertEqual(len(misses), 6)
+        self.assertEqual(X.misses_line(misses, "T."), "T. 6 missed (3 on cbox-specular, the scene the issue sets them for):")
+        self.assertEqual(X.misses_line(misses[:3], "T."), "T. 3 missed:")  # cbox-specular's alone
+        self.assertEqual(X.misses_line([], "T."), "T. All met.")
+        self.assertIn("6 missed (3 on cbox-specular", "\n".join(X.table1_html(c, summary, "t")))
+
     def test_a_missing_column_is_a_dash_and_skipped_by_the_ordering(self):
         c = X.settings(paper=True, scenes=["cbox-specular"])
         good = [(0.5, 2.0), (0.2, 0.3), (0.15, 0.2), (0.01, 0.02)]
