@@ -107,7 +107,14 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
         write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}, true});
         return latent;
     }
-    display_rgb = read_fit_image(rgb_file, 3, width, height).data;
+    Image cached = read_fit_image(rgb_file, 3, width, height);
+    if (!cached.display) {
+        // Written before EXRs carried the display mark (43b57c8): the same display values, unmarked,
+        // which `metrics` would read as linear and map twice. Marked in place, pixels unchanged.
+        cached.display = true;
+        write_exr(rgb_file, cached);
+    }
+    display_rgb = std::move(cached.data);
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});
     if (fs::exists(latent_file)) return read_fit_image(latent_file, channels, width / f, height / f).data;
     std::vector<float> latent = vae.encode(display_rgb, width, height);

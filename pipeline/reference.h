@@ -63,7 +63,8 @@ std::string reference_seed_suffix(uint64_t seed);
 /// latent file is missing); a missing one is traced and both files written, latent first, each
 /// atomically, so several jobs (an experiment's fits and edit sequences) trace a reference once
 /// and encode it once. An empty `cache_stem` caches nothing. `display_rgb` receives the display
-/// image and `save_png` (if not empty) a picture of it.
+/// image and `save_png` (if not empty) a picture of it. A cached EXR without the display mark
+/// (written before EXRs had one) is rewritten with it, its pixels unchanged.
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
                                             const std::string& save_png, std::vector<float>& display_rgb,

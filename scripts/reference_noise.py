@@ -76,8 +76,8 @@ class Scorer:
 
 def display_png(exr, png):
     """A cached reference holds display values in an EXR; caches written before 2026-11-30 lack the
-    header mark `latentpt metrics` reads them by (it would take them for linear), so hand it a
-    16-bit PNG of the same values (no colour conversion)."""
+    header mark `latentpt metrics` reads them by (it would take them for linear) until a fit or
+    edit job reads them again, so hand it a 16-bit PNG of the same values (no colour conversion)."""
     subprocess.run(["oiiotool", exr, "-d", "uint16", "-o", png], check=True)
 
 

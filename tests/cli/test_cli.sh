@@ -238,6 +238,15 @@ if [ -d "$shared/models/taesd3" ]; then
     # From the cache: the same references, so the same metrics.
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2c"
     check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
+    # A cache written before EXRs carried the display mark: read as before and marked in place.
+    f1="$out/refs/move_16x16_2spp_clip_frame_0001_own_seed.exr"
+    cp "$f1" "$out/marked.exr"
+    oiiotool "$out/marked.exr" --eraseattrib "latentpt:values" -o "$f1"
+    check sh -c "! oiiotool --info -v '$f1' | grep -q '^ *latentpt:values: '"  # oiiotool's history names it
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2u"
+    check cmp "$out/ed2/metrics.csv" "$out/ed2u/metrics.csv"
+    check sh -c "oiiotool --info -v '$f1' | grep -q '^ *latentpt:values: \"display\"'"
+    check cmp "$out/marked.exr" "$f1"
     # Another --ref-seed: independent references of the same frames under their own cache names
     # (the edited frame's and the training view's), the default seed's files untouched.
     cp -r "$out/refs" "$out/refs_before"
