@@ -165,9 +165,13 @@ void PathTracer<N>::resolve_hits(TileWorkspace<N>& ws, int cur, int depth) const
             }
         }
         // Latent: Ĩa at the first non-delta vertex of E S* D; its light sample decides Ĩc.
-        // Before it, the back of a one-sided surface scores the background (docs/transport.md (6)).
-        const bool gate_here = m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id),
-                                                         !m_scatters_below[shape_id] && si.sh.n.dot(wi_world) <= 0.f);
+        // Before it, the back of a one-sided surface scores the background (docs/transport.md (6)):
+        // black in RGB like the void, so a camera ray that meets it takes the void's look if an
+        // edit gives the void one.
+        const bool black_side = !m_scatters_below[shape_id] && si.sh.n.dot(wi_world) <= 0.f;
+        if (black_side && depth == 0 && m_latent && m_latent->camera_look(p, slot, -1)) continue;
+        const bool gate_here =
+            m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id), black_side);
         // Without Ĩe nothing is collected after the first non-delta vertex.
         const bool cont = may_continue && (m_emission || !p.past_first[slot]);
         const uint8_t flags = (cont ? ShadeQueue::kContinue : 0) | (gate_here ? ShadeQueue::kFirst : 0);

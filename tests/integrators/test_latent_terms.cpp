@@ -175,19 +175,29 @@ TEST(LatentTerms, TheBackOfAOneSidedSurfaceShowsTheBackground) {
 // Edits of what the training view never showed (LatentTerms::looks): camera rays that hit
 // nothing, or the emitting side of a shape given a look, score that look into Ĩa and nothing
 // else (no environment L̃e, no b̃, no emission); every other pixel renders exactly as before.
-TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
-    // Looking straight down at the edge (x = 100) of a plane that emits upwards: half of the
-    // pixels see the plane, the others nothing but the constant environment.
+namespace {
+
+/// Looking straight at the edge (x = 100) of a plane that emits upwards from `camera_z` above it
+/// (below: its back, one-sided diffuse): half of the pixels see the plane, the others nothing but
+/// the constant environment.
+Scene plane_edge_scene(float camera_z) {
     const std::string json = R"({
       "integrator": {"max_depth": 3, "rr_depth": 100},
       "camera": {"fov": 20, "width": 8, "height": 8, "filter": {"type": "box"}, "near_clip": 1e-4,
-                 "to_world": {"lookat": {"origin": [100, 0, 1], "target": [100, 0, 0], "up": [0, 1, 0]}}},
+                 "to_world": {"lookat": {"origin": [100, 0, )" + std::to_string(camera_z) +
+                             R"(], "target": [100, 0, 0], "up": [0, 1, 0]}}},
       "materials": {"plane": {"type": "diffuse", "reflectance": 0.5}},
       "shapes": [{"id": "plane", "type": "rectangle", "material": "plane", "to_world": {"scale": [100, 100, 1]},
                   "emitter": {"type": "area", "radiance": 3}}],
       "emitters": [{"type": "constant", "radiance": 2}]
     })";
-    const Scene scene = load_scene(test::write_temp_file("plane_edge.json", json));
+    return load_scene(test::write_temp_file(camera_z > 0 ? "plane_edge.json" : "plane_edge_below.json", json));
+}
+
+}  // namespace
+
+TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
+    const Scene scene = plane_edge_scene(1.f);
     auto spectra = SceneSpectra<16>::from_description(scene);
     const int plane = scene.find_shape("plane");
     LatentTerms<16> t = zero_terms(scene);
@@ -231,4 +241,42 @@ TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
         EXPECT_EQ(surface, 32);
         EXPECT_EQ(nothing, 32);
     }
+}
+
+// From below, the same edge shows the plane's back, where a one-sided diffuse scatters nothing:
+// RGB renders it black, as the void beside it, and before looks both score b̃. Given a look for
+// nothing, both score that look, and nothing else.
+TEST(LatentTerms, CameraRaysMeetingABlackBackScoreTheLookOfNothing) {
+    const Scene scene = plane_edge_scene(-1.f);
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    const int plane = scene.find_shape("plane");
+    LatentTerms<16> t = zero_terms(scene);
+    t.La[plane] = ramp(-0.3f, 0.8f);
+    t.Lc[plane] = ramp(0.4f, 0.3f);
+    t.background = ramp(0.2f, -0.6f);
+    const S16 v_nothing = ramp(1.5f, -2.f);
+    LatentTerms<16> u = t;
+    u.looks = {v_nothing};
+    u.look_of_nothing = 0;
+    const TermFilms<16> before = render_latent_terms<16>(scene, spectra, t, options(scene));
+    const TermFilms<16> after = render_latent_terms<16>(scene, spectra, u, options(scene));
+    const std::vector<float> e0 = before.e.develop(), a0 = before.a.develop();
+    const std::vector<float> e1 = after.e.develop(), a1 = after.a.develop(), c1 = after.c.develop();
+    const S16 env = spectra.radiance[scene.environment];
+    int back = 0, nothing = 0;
+    for (size_t p = 0; p < e0.size() / 16; ++p) {
+        const bool missed = std::abs(e0[p * 16] - env[0]) < 1e-6f;  // the back emits nothing
+        back += !missed;
+        nothing += missed;
+        for (int k = 0; k < 16; ++k) {
+            const size_t i = p * 16 + k;
+            EXPECT_NEAR(a0[i], t.background[k], 1e-6f) << "before: the back, as the void, scores b̃ " << p;
+            if (!missed) EXPECT_NEAR(e0[i], 0.f, 1e-6f) << p;
+            EXPECT_NEAR(a1[i], v_nothing[k], 1e-6f) << p;
+            EXPECT_EQ(e1[i], 0.f) << p;
+            EXPECT_EQ(c1[i], 0.f) << p;
+        }
+    }
+    EXPECT_EQ(back, 32);
+    EXPECT_EQ(nothing, 32);
 }
