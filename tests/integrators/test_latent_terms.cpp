@@ -184,7 +184,8 @@ Scene plane_edge_scene(float camera_z) {
     const std::string json = R"({
       "integrator": {"max_depth": 3, "rr_depth": 100},
       "camera": {"fov": 20, "width": 8, "height": 8, "filter": {"type": "box"}, "near_clip": 1e-4,
-                 "to_world": {"lookat": {"origin": [100, 0, )" + std::to_string(camera_z) +
+                 "to_world": {"lookat": {"origin": [100, 0, )" +
+                             std::to_string(camera_z) +
                              R"(], "target": [100, 0, 0], "up": [0, 1, 0]}}},
       "materials": {"plane": {"type": "diffuse", "reflectance": 0.5}},
       "shapes": [{"id": "plane", "type": "rectangle", "material": "plane", "to_world": {"scale": [100, 100, 1]},
