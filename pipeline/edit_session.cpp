@@ -34,7 +34,12 @@ EditSession::EditSession(const std::string& fitdir, const std::string& edits,
                          const std::map<std::string, std::string>& defines, std::optional<SamplerKind> sampler)
     : m_fit(load_fit_folder(fitdir, defines, sampler)),
       m_edits(load_edits(edits, *m_fit.scene)),
-      m_camera(m_fit.scene->camera) {
+      m_camera(m_fit.scene->camera),
+      m_overridden(!defines.empty()) {
+    // What the training view showed: the scene as fitted, not as the overrides leave it.
+    std::unique_ptr<Scene> fitted;
+    if (m_overridden) fitted = std::make_unique<Scene>(load_fitted_scene(m_fit));
+    const Scene& training_view = fitted ? *fitted : *m_fit.scene;
     const fs::path pt = fs::path(fitdir) / "refiner.pt";
     if (fs::exists(pt)) m_refiner = Refiner::load(pt.string());
     const fs::path emitters = fs::path(fitdir) / kEmitterRefinerFile;
@@ -45,10 +50,10 @@ EditSession::EditSession(const std::string& fitdir, const std::string& edits,
                                      "main refiner (latentpt refine) or remove the file");
         m_emitter_refiner = Refiner::load(emitters.string());
         check_emitter_refiner_inputs(m_refiner->config(), m_emitter_refiner->config(), emitters.string());
-        m_training_coverage = emitter_coverage(*m_fit.scene, m_fit.latent_width, m_fit.latent_height);
+        m_training_coverage = emitter_coverage(training_view, m_fit.latent_width, m_fit.latent_height);
     }
     for (const Shape& s : m_fit.scene->shapes) m_original.push_back(s.mesh);
-    m_unseen = UnseenEmitters(m_fit);
+    m_unseen = UnseenEmitters(m_fit, fitted.get());
 }
 
 FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int height) {
@@ -56,7 +61,7 @@ FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int he
         throw std::invalid_argument("frame " + std::to_string(i) +
                                     " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
     apply_edits(m_edits, time(i), m_original, m_camera, *m_fit.scene);
-    m_unseen.show(m_fit.model->terms(), m_fit.tone, m_fit.scene->shapes.size(), !unedited(i));
+    m_unseen.show(m_fit.model->terms(), m_fit.tone, m_fit.scene->shapes.size(), m_overridden || !unedited(i));
     return edited_frame(m_fit, m_refiner.get(), m_emitter_refiner.get(), m_training_coverage,
                         width > 0 ? width : m_fit.latent_width, height > 0 ? height : m_fit.latent_height, spp,
                         seed + uint64_t(i));

@@ -52,10 +52,13 @@ private:
     EditSequence m_edits;
     std::unique_ptr<Refiner> m_refiner;
     std::unique_ptr<Refiner> m_emitter_refiner;  ///< refiner_emitters.pt, when the fit folder has one
-    std::vector<float> m_training_coverage;      ///< with it: emitter_coverage of the unedited view
+    std::vector<float> m_training_coverage;      ///< with it: emitter_coverage of the training view
     UnseenEmitters m_unseen;
     std::vector<TriangleMesh> m_original;
     Camera m_camera;
+    /// -D overrides were given: no frame is then the training view, and what it showed is
+    /// measured on the scene as fitted.
+    bool m_overridden = false;
 };
 
 }  // namespace lpt::pipeline

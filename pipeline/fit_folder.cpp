@@ -148,6 +148,16 @@ VaeSource vae_source_of(const nlohmann::json& m) {
 
 VaeSource manifest_vae(const std::string& path) { return vae_source_of(parse_json_file(path)); }
 
+Scene load_fitted_scene(const FitFolder& fit) {
+    const std::string manifest_path = (fs::path(fit.dir) / "fit.json").string();
+    try {
+        return load_scene(fit.manifest.at("scene").get<std::string>(),
+                          fit.manifest.value("defines", std::map<std::string, std::string>{}));
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(manifest_path + ": " + e.what());
+    }
+}
+
 Image read_fit_image(const std::string& path, int channels, int w, int h) {
     if (!fs::exists(path)) throw std::runtime_error(path + ": missing (run latentpt fit first)");
     Image img = read_image(path);

@@ -40,6 +40,10 @@ struct FitFolder {
 FitFolder load_fit_folder(const std::string& dir, const std::map<std::string, std::string>& defines = {},
                           std::optional<SamplerKind> sampler = std::nullopt);
 
+/// The scene as fitted, with fit.json's own -D values only: what the training view showed, which
+/// a FitFolder loaded with other defines (a camera's field of view) may no longer be.
+Scene load_fitted_scene(const FitFolder& fit);
+
 /// The fitted model's tone-mapped latent of its (possibly edited) scene at w × h, spp and seed:
 /// what edited frames and the refiner's extra training renders are made of.
 std::vector<float> render_fit_latent(const FitFolder& fit, int w, int h, int spp, uint64_t seed);

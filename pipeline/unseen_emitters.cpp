@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 namespace lpt::pipeline {
 
@@ -37,9 +38,14 @@ Eigen::Array3f environment_radiance(const Scene& scene) {
 
 }  // namespace
 
-UnseenEmitters::UnseenEmitters(const FitFolder& fit) {
+UnseenEmitters::UnseenEmitters(const FitFolder& fit, const Scene* training_view) {
     if (!vae_present(fit.vae)) return;
     const Scene& scene = *fit.scene;
+    const Scene& seen_from = training_view ? *training_view : scene;
+    if (seen_from.shapes.size() != scene.shapes.size())
+        throw std::runtime_error(fit.dir + ": the -D overrides change the scene's shapes (" +
+                                 std::to_string(scene.shapes.size()) + " against " +
+                                 std::to_string(seen_from.shapes.size()) + " as fitted)");
     std::vector<int> candidates;  // the area emitters' shapes, then -1: rays that hit nothing
     std::vector<Eigen::Array3f> radiance;
     for (const Emitter& e : scene.emitters)
@@ -52,7 +58,7 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit) {
     // At least 256 rays across the narrower side: on a latent of a few pixels, 8 × 8 per pixel
     // could step over a gap between a wall and the view's edge that the render's samples find.
     const int w = fit.latent_width, h = fit.latent_height, rays = std::max(8, (255 + std::min(w, h)) / std::min(w, h));
-    const std::vector<float> seen = render_shape_coverage(scene, w, h, candidates, rays);
+    const std::vector<float> seen = render_shape_coverage(seen_from, w, h, candidates, rays);
     std::unique_ptr<Vae> vae;
     for (size_t s = 0; s < candidates.size(); ++s) {
         bool any = false;

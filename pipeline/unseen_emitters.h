@@ -24,11 +24,13 @@ namespace lpt::pipeline {
 class UnseenEmitters {
 public:
     UnseenEmitters() = default;
-    /// The area emitters of `fit`'s scene (as loaded: the training view) that no camera ray of it
-    /// meets, the environment if every one meets a surface, and the latent of each from the fit's
-    /// VAE (opened only if there are any). None when the VAE is not here (frames are then latents
-    /// only, nothing decodes them).
-    explicit UnseenEmitters(const FitFolder& fit);
+    /// The area emitters of `fit`'s scene that no camera ray of the training view meets, the
+    /// environment if every one meets a surface, and the latent of each (its colour in `fit`'s
+    /// scene) from the fit's VAE (opened only if there are any). The training view is
+    /// `training_view` when given (the scene as fitted, where `fit` was loaded with -D overrides
+    /// that may change what the camera sees), else `fit`'s scene. None when the VAE is not here
+    /// (frames are then latents only, nothing decodes them).
+    explicit UnseenEmitters(const FitFolder& fit, const Scene* training_view = nullptr);
     /// No unseen area emitter (the environment aside).
     bool empty() const { return m_shapes.empty(); }
     /// The unseen area emitters' shapes.

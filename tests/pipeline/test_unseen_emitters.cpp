@@ -14,6 +14,7 @@
 #include "test_util.h"
 #include "vae/vae.h"
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <cmath>
 
 using namespace lpt;
@@ -159,4 +160,37 @@ TEST(UnseenEmitters, ACameraPannedPastTheWallsSeesTheVoidAsBlack) {
     }
     EXPECT_GE(void_pixels, 16) << "the orbit looks past the box";
     EXPECT_GE(seen_pixels, 16);
+}
+
+// -D overrides at edit time may widen the view past the walls. What the training view showed is
+// still judged on the scene as fitted (the void unseen), and with overrides no frame is the
+// training view, so frame 0 shows the void in its look too.
+TEST(UnseenEmitters, OverridesThatWidenTheViewKeepTheTrainingViewsVerdict) {
+    if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
+    const std::string dir = test::temp_dir("unseen-overridden");
+    const pipeline::FitJob job = small_fit(kBox, {{"camera.fov", "25"}}, dir);  // the box fills the view
+    const std::string edits = test::write_temp_file("still.json", R"({ "frames": 1 })");
+    pipeline::EditSession session(job.out, edits, {{"camera.fov", "70"}});
+    ASSERT_TRUE(session.unseen_emitters().environment_unseen()) << "judged on the view as fitted";
+    const pipeline::FrameLatents f = session.frame(0, 2, 0);
+    const std::vector<float> nothing = render_shape_coverage(*session.fit().scene, 16, 16, {-1});
+    const std::unique_ptr<Vae> vae = pipeline::open_vae(session.fit().vae);
+    const float black[3] = {0.f, 0.f, 0.f};
+    const std::vector<float> look = pipeline::flat_colour_latent(*vae, black);
+    // the camera's tent filter reaches a pixel beyond each pixel: a pixel and its neighbours see nothing
+    auto all_void_around = [&](int x, int y) {
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int u = std::clamp(x + dx, 0, 15), v = std::clamp(y + dy, 0, 15);
+                if (nothing[size_t(v) * 16 + u] < 1.f) return false;
+            }
+        return true;
+    };
+    int void_pixels = 0;
+    for (size_t p = 0; p < nothing.size(); ++p) {
+        if (!all_void_around(int(p % 16), int(p / 16))) continue;
+        ++void_pixels;
+        for (int k = 0; k < 16; ++k) EXPECT_NEAR(f.latent[p * 16 + k], look[k], 1e-4f) << p << " " << k;
+    }
+    EXPECT_GE(void_pixels, 16) << "the wider view looks past the box";
 }
