@@ -60,6 +60,7 @@ FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int he
     if (i < 0 || i >= m_edits.frames)
         throw std::invalid_argument("frame " + std::to_string(i) +
                                     " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
+    const std::lock_guard<std::mutex> one_frame_at_a_time(m_frame_mutex);
     apply_edits(m_edits, time(i), m_original, m_camera, *m_fit.scene);
     m_unseen.show(m_fit.model->terms(), m_fit.tone, m_fit.scene->shapes.size(), m_overridden || !unedited(i));
     return edited_frame(m_fit, m_refiner.get(), m_emitter_refiner.get(), m_training_coverage,

@@ -9,6 +9,7 @@
 #include "refiner/refiner.h"
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,8 @@ public:
     float time(int i) const { return float(i) / float(m_edits.frames); }
     /// Frame i as `render --edit --seed seed` renders it (0 = the fit's latent resolution): the
     /// scene is edited to time(i) and rendered with seed + i, so a frame depends on i alone.
+    /// Calls from several threads (Python's, which frame() lets run) take turns: each edits the
+    /// one scene the session holds.
     FrameLatents frame(int i, int spp = 64, uint64_t seed = 0, int width = 0, int height = 0);
     /// Whether frame i is the scene as fitted (core/scene_edit.h is_unedited).
     bool unedited(int i) const { return is_unedited(m_edits, time(i)); }
@@ -59,6 +62,7 @@ private:
     /// -D overrides were given: no frame is then the training view, and what it showed is
     /// measured on the scene as fitted.
     bool m_overridden = false;
+    std::mutex m_frame_mutex;  ///< frame() edits m_fit's scene and terms in place
 };
 
 }  // namespace lpt::pipeline

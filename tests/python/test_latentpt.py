@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import unittest
 
 import numpy as np
@@ -234,6 +235,19 @@ class PipelineTest(unittest.TestCase):
             self.assertEqual(frame["latent"].shape, (8, 8, 16))
             self.assertIsNone(frame["refined"])  # this fit ran without a refiner
             self.assertFalse(np.array_equal(frame["latent"], session.frame(0, spp=2)["latent"]))
+            # frame() lets other Python threads run; frames asked for from several at once come out
+            # as serial calls render them (each call edits the session's one scene)
+            serial = [session.frame(i, spp=2)["latent"] for i in range(session.frames)]
+            for _ in range(4):  # unguarded, one round in three crashed in Embree
+                together = [None] * session.frames
+                threads = [threading.Thread(target=lambda i=i: together.__setitem__(i, session.frame(i, spp=2)["latent"]))
+                           for i in range(session.frames)]
+                for t in threads:
+                    t.start()
+                for t in threads:
+                    t.join()
+                for i in range(session.frames):
+                    np.testing.assert_array_equal(together[i], serial[i], err_msg=f"frame {i}")
             shared = os.environ.get("LATENTPT_SHARED", os.path.join(SRC, "..", "shared"))
             if os.path.exists(os.path.join(shared, "models", "taesd3", "taesd3_decoder.safetensors")):
                 rgb = latentpt.Vae.from_fit(os.path.join(d, "fit")).decode(frame["latent"])
