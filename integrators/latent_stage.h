@@ -24,9 +24,12 @@ public:
         if (m_terms.looks.empty()) return false;
         const std::vector<int>& of_shape = m_terms.look_of_shape;  // empty: no shape has one
         const int i = shape < 0 ? m_terms.look_of_nothing : size_t(shape) < of_shape.size() ? of_shape[shape] : -1;
-        if (i < 0) return false;
-        p.ambient[slot] += ambient_score(p.beta[slot], m_terms.looks[i]);
-        return true;
+        return score_look(p, slot, i);
+    }
+
+    /// camera_look for a camera ray that meets the black back of a one-sided surface.
+    bool camera_look_of_black(PathState<N>& p, uint32_t slot) const {
+        return score_look(p, slot, m_terms.look_of_black);
     }
 
     /// A path escaped (or met a surface's black side, see hit()): the background joins Ĩa
@@ -69,6 +72,13 @@ public:
     }
 
 private:
+    /// Scores looks[i] into Ĩa (true), or nothing where i < 0 (false).
+    bool score_look(PathState<N>& p, uint32_t slot, int i) const {
+        if (i < 0) return false;
+        p.ambient[slot] += ambient_score(p.beta[slot], m_terms.looks[size_t(i)]);
+        return true;
+    }
+
     const LatentTerms<N>& m_terms;
     PathObserver<N>* m_obs;
 };

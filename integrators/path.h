@@ -51,10 +51,10 @@ struct LatentTerms {
     /// Edits only (pipeline/unseen_emitters.h): what a camera ray scores, into Ĩa and nothing
     /// else, where it first meets what the training view never showed: looks[look_of_shape[s]]
     /// on the emitting side of shape s (where that index is ≥ 0), looks[look_of_nothing] where it
-    /// hits nothing. Empty and -1: none. Never in a render with an observer (a fit's adjoint does
-    /// not know them).
+    /// hits nothing, looks[look_of_black] where it meets the black back of a one-sided surface.
+    /// Empty and -1: none. Never in a render with an observer (a fit's adjoint does not know them).
     std::vector<int> look_of_shape;
-    int look_of_nothing = -1;
+    int look_of_nothing = -1, look_of_black = -1;
     std::vector<Spectrum<N>, Eigen::aligned_allocator<Spectrum<N>>> looks;
     OcclusionGate gate = OcclusionGate::Shadowed;
     bool emission = true, ambient = true, occlusion = true;  ///< which of Ĩe, Ĩa, Ĩc to render

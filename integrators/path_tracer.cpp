@@ -165,11 +165,10 @@ void PathTracer<N>::resolve_hits(TileWorkspace<N>& ws, int cur, int depth) const
             }
         }
         // Latent: Ĩa at the first non-delta vertex of E S* D; its light sample decides Ĩc.
-        // Before it, the back of a one-sided surface scores the background (docs/transport.md (6)):
-        // black in RGB like the void, so a camera ray that meets it takes the void's look if an
-        // edit gives the void one.
+        // Before it, the back of a one-sided surface scores the background (docs/transport.md (6)),
+        // or, seen by a camera ray in an edit that gives black a look, that look: RGB shows it black.
         const bool black_side = !m_scatters_below[shape_id] && si.sh.n.dot(wi_world) <= 0.f;
-        if (black_side && depth == 0 && m_latent && m_latent->camera_look(p, slot, -1)) continue;
+        if (black_side && depth == 0 && m_latent && m_latent->camera_look_of_black(p, slot)) continue;
         const bool gate_here =
             m_latent && m_latent->hit(p, slot, shape_id, m_spectra.is_delta(m_scene, shape_id), black_side);
         // Without Ĩe nothing is collected after the first non-delta vertex.

@@ -69,6 +69,9 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit, const Scene* training_view)
         if (!vae) vae = open_vae(fit.vae);
         std::vector<float> look = flat_colour_latent(*vae, rgb);
         if (candidates[s] < 0) {
+            const bool black = rgb[0] == 0.f && rgb[1] == 0.f && rgb[2] == 0.f;  // no environment
+            const float zero[3] = {0.f, 0.f, 0.f};
+            m_black = black ? look : flat_colour_latent(*vae, zero);
             m_environment = std::move(look);
         } else {
             m_shapes.push_back(candidates[s]);
@@ -80,6 +83,7 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit, const Scene* training_view)
 void UnseenEmitters::show(LatentTerms<kLatentChannels>& terms, ToneCurve tone, size_t shapes, bool on) const {
     terms.look_of_shape.clear();
     terms.look_of_nothing = -1;
+    terms.look_of_black = -1;
     terms.looks.clear();
     if (!on || (m_shapes.empty() && !m_environment)) return;
     auto add = [&](const std::vector<float>& look) {
@@ -91,6 +95,7 @@ void UnseenEmitters::show(LatentTerms<kLatentChannels>& terms, ToneCurve tone, s
     terms.look_of_shape.assign(shapes, -1);
     for (size_t s = 0; s < m_shapes.size(); ++s) terms.look_of_shape[m_shapes[s]] = add(m_looks[s]);
     if (m_environment) terms.look_of_nothing = add(*m_environment);
+    if (m_black) terms.look_of_black = add(*m_black);
 }
 
 }  // namespace lpt::pipeline

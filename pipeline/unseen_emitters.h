@@ -36,6 +36,10 @@ public:
     /// The unseen area emitters' shapes.
     const std::vector<int>& shapes() const { return m_shapes; }
     bool environment_unseen() const { return m_environment.has_value(); }
+    /// Black's latent, which the black backs of one-sided surfaces take where the environment is
+    /// unseen (they then met no camera ray of the training view but as surfaces; RGB shows them
+    /// black, not in the environment's colour).
+    const std::optional<std::vector<float>>& black() const { return m_black; }
     /// Gives `terms` (of a scene with `shapes` shapes) the looks, as linear latents under `tone`
     /// (the renderer mixes a look into a pixel in proportion to its rays that meet it, before the
     /// tone curve, as it mixes everything else); with `on` false, takes them away.
@@ -45,6 +49,7 @@ private:
     std::vector<int> m_shapes;                        ///< the unseen emitters' shapes
     std::vector<std::vector<float>> m_looks;          ///< each one's latent (channels values)
     std::optional<std::vector<float>> m_environment;  ///< the environment's latent, when unseen
+    std::optional<std::vector<float>> m_black;        ///< black's latent, with it
 };
 
 /// The latent of a flat image of display colour `rgb`: the mean over the inner half of a 64²

@@ -245,9 +245,9 @@ TEST(LatentTerms, CameraRaysScoreTheLooksEditsGive) {
 }
 
 // From below, the same edge shows the plane's back, where a one-sided diffuse scatters nothing:
-// RGB renders it black, as the void beside it, and before looks both score b̃. Given a look for
-// nothing, both score that look, and nothing else.
-TEST(LatentTerms, CameraRaysMeetingABlackBackScoreTheLookOfNothing) {
+// RGB renders it black, and before looks it scores b̃ as the void beside it does. Given looks for
+// nothing and for black, each scores its own, and nothing else.
+TEST(LatentTerms, CameraRaysMeetingABlackBackScoreTheLookOfBlack) {
     const Scene scene = plane_edge_scene(-1.f);
     auto spectra = SceneSpectra<16>::from_description(scene);
     const int plane = scene.find_shape("plane");
@@ -255,10 +255,11 @@ TEST(LatentTerms, CameraRaysMeetingABlackBackScoreTheLookOfNothing) {
     t.La[plane] = ramp(-0.3f, 0.8f);
     t.Lc[plane] = ramp(0.4f, 0.3f);
     t.background = ramp(0.2f, -0.6f);
-    const S16 v_nothing = ramp(1.5f, -2.f);
+    const S16 v_nothing = ramp(1.5f, -2.f), v_black = ramp(-0.8f, 1.1f);
     LatentTerms<16> u = t;
-    u.looks = {v_nothing};
+    u.looks = {v_nothing, v_black};
     u.look_of_nothing = 0;
+    u.look_of_black = 1;
     const TermFilms<16> before = render_latent_terms<16>(scene, spectra, t, options(scene));
     const TermFilms<16> after = render_latent_terms<16>(scene, spectra, u, options(scene));
     const std::vector<float> e0 = before.e.develop(), a0 = before.a.develop();
@@ -273,7 +274,7 @@ TEST(LatentTerms, CameraRaysMeetingABlackBackScoreTheLookOfNothing) {
             const size_t i = p * 16 + k;
             EXPECT_NEAR(a0[i], t.background[k], 1e-6f) << "before: the back, as the void, scores b̃ " << p;
             if (!missed) EXPECT_NEAR(e0[i], 0.f, 1e-6f) << p;
-            EXPECT_NEAR(a1[i], v_nothing[k], 1e-6f) << p;
+            EXPECT_NEAR(a1[i], (missed ? v_nothing : v_black)[k], 1e-6f) << p;
             EXPECT_EQ(e1[i], 0.f) << p;
             EXPECT_EQ(c1[i], 0.f) << p;
         }

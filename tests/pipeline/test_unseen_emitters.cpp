@@ -194,3 +194,36 @@ TEST(UnseenEmitters, OverridesThatWidenTheViewKeepTheTrainingViewsVerdict) {
     }
     EXPECT_GE(void_pixels, 16) << "the wider view looks past the box";
 }
+
+// Where the environment is unseen, the black backs of one-sided surfaces take black's latent,
+// not the environment's: the box, narrowed to fill its view, under a grey sky.
+TEST(UnseenEmitters, BlackBacksTakeBlacksLookNotTheSkys) {
+    if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
+    const std::string dir = test::temp_dir("unseen-sky");
+    std::string text = read_file(kBox);
+    const size_t at = text.find("\"shapes\":");
+    ASSERT_NE(at, std::string::npos) << "the box's shapes entry moved: update this test";
+    text.insert(at, R"("emitters": [{ "type": "constant", "radiance": 0.2 }],
+  )");
+    const std::string scene = dir + "/scene.json";
+    write_text_atomic(scene, text);
+    const pipeline::FitJob job = small_fit(scene, {{"camera.fov", "25"}}, dir);
+    const pipeline::FitFolder fit = pipeline::load_fit_folder(job.out);
+    const pipeline::UnseenEmitters unseen(fit);
+    ASSERT_TRUE(unseen.environment_unseen());
+    ASSERT_TRUE(unseen.black().has_value());
+    const std::unique_ptr<Vae> vae = pipeline::open_vae(fit.vae);
+    const float black[3] = {0.f, 0.f, 0.f};
+    EXPECT_EQ(*unseen.black(), pipeline::flat_colour_latent(*vae, black));
+    LatentTerms<kLatentChannels> terms;
+    unseen.show(terms, fit.tone, fit.scene->shapes.size(), true);
+    ASSERT_GE(terms.look_of_black, 0);
+    ASSERT_GE(terms.look_of_nothing, 0);
+    float apart = 0.f;  // the sky's look is another latent
+    for (int k = 0; k < kLatentChannels; ++k)
+        apart = std::max(apart, std::abs(terms.looks[size_t(terms.look_of_black)][k] -
+                                         terms.looks[size_t(terms.look_of_nothing)][k]));
+    EXPECT_GT(apart, 0.1f);
+    unseen.show(terms, fit.tone, fit.scene->shapes.size(), false);
+    EXPECT_EQ(terms.look_of_black, -1);
+}
