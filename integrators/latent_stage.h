@@ -74,7 +74,7 @@ public:
 private:
     /// Scores looks[i] into Ĩa (true), or nothing where i < 0 (false).
     bool score_look(PathState<N>& p, uint32_t slot, int i) const {
-        if (i < 0) return false;
+        if (i < 0 || size_t(i) >= m_terms.looks.size()) return false;
         p.ambient[slot] += ambient_score(p.beta[slot], m_terms.looks[size_t(i)]);
         return true;
     }

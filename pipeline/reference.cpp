@@ -110,9 +110,12 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
     Image cached = read_fit_image(rgb_file, 3, width, height);
     if (!cached.display) {
         // Written before EXRs carried the display mark (43b57c8): the same display values, unmarked,
-        // which `metrics` would read as linear and map twice. Marked in place, pixels unchanged.
+        // which `metrics` would read as linear and map twice. Marked in place, pixels unchanged;
+        // a cache this process may only read (another user's folder) stays as it is.
         cached.display = true;
-        write_exr(rgb_file, cached);
+        try {
+            write_exr(rgb_file, cached);
+        } catch (const std::exception&) {}
     }
     display_rgb = std::move(cached.data);
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});

@@ -34,7 +34,7 @@ def misses_line(misses, lead):
     if not misses:
         return lead + " All met."
     own = sum(1 for x in misses if x.startswith(ISSUE_SCENE + "/"))
-    scope = f" ({own} on {ISSUE_SCENE}, the scene the issue sets them for)" if own < len(misses) else ""
+    scope = f" ({own} on {ISSUE_SCENE}, the scene the issue sets them for)" if 0 < own < len(misses) else ""
     return f"{lead} {len(misses)} missed{scope}:"
 
 

@@ -188,6 +188,7 @@ class Table1(unittest.TestCase):
         self.assertEqual(len(misses), 6)
         self.assertEqual(X.misses_line(misses, "T."), "T. 6 missed (3 on cbox-specular, the scene the issue sets them for):")
         self.assertEqual(X.misses_line(misses[:3], "T."), "T. 3 missed:")  # cbox-specular's alone
+        self.assertEqual(X.misses_line(misses[3:], "T."), "T. 3 missed:")  # a table without it
         self.assertEqual(X.misses_line([], "T."), "T. All met.")
         self.assertIn("6 missed (3 on cbox-specular", "\n".join(X.table1_html(c, summary, "t")))
 
