@@ -1,6 +1,9 @@
 #include "integrators/aov.h"
 #include "core/sampler.h"
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
+#include <algorithm>
+#include <cmath>
 
 namespace lpt {
 
@@ -89,6 +92,51 @@ std::vector<float> render_shape_coverage(const Scene& scene, int width, int heig
             if (si.shape == shapes[s]) out[p * k + s] += 1.f / float(rays_per_side * rays_per_side);
     });
     return out;
+}
+
+CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height,
+                           int rays_per_side) {
+    const Camera camera = scene.camera.with_resolution(width, height);
+    const float margin = std::max(0.f, camera.filter.radius - 0.5f);
+    const int n = rays_per_side;
+    const int columns = int(std::ceil((float(width) + 2.f * margin) * float(n)));
+    const int rows = int(std::ceil((float(height) + 2.f * margin) * float(n)));
+    std::vector<char> scatters_below(scene.shapes.size());
+    for (size_t s = 0; s < scene.shapes.size(); ++s)
+        scatters_below[s] = spectra.bsdf_of(scene, int(s)).scatters_from_below();
+    struct Tally {  // per thread; integers, so that the sum does not depend on the threads' order
+        std::vector<char> front_of;
+        uint64_t black_back_rays = 0;
+        bool nothing = false;
+    };
+    tbb::combinable<Tally> tallies([&] { return Tally{std::vector<char>(scene.shapes.size(), 0)}; });
+    tbb::parallel_for(0, rows, [&](int j) {
+        set_ftz_daz();
+        Tally& mine = tallies.local();
+        for (int i = 0; i < columns; ++i) {
+            const Vec2f film(-margin + (float(i) + 0.5f) / float(n), -margin + (float(j) + 0.5f) / float(n));
+            const Ray r = camera.generate_ray(film);
+            const SurfaceInteraction si = scene.intersect(r);
+            if (!si.valid()) {
+                mine.nothing = true;
+                continue;
+            }
+            // the path tracer's sides: an emitter's shading normal is its emission normal
+            const bool front = si.sh.n.dot(-r.d) > 0.f;
+            if (front) mine.front_of[size_t(si.shape)] = 1;
+            if (!front && !scatters_below[size_t(si.shape)]) ++mine.black_back_rays;
+        }
+    });
+    CameraSights all;
+    all.front_of.assign(scene.shapes.size(), 0);
+    uint64_t black_back_rays = 0;
+    tallies.combine_each([&](const Tally& t) {
+        for (size_t s = 0; s < t.front_of.size(); ++s) all.front_of[s] |= t.front_of[s];
+        black_back_rays += t.black_back_rays;
+        all.nothing |= t.nothing;
+    });
+    all.black_back_pixels = float(double(black_back_rays) / double(n * n));
+    return all;
 }
 
 }  // namespace lpt

@@ -26,6 +26,21 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
 /// (docs/refiner.md "Emitter cells"). width × height × cells² values, sub-cells row-major.
 std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side = 4);
 
+/// What the camera's rays meet first anywhere they land: on the film, and past its edges as far as
+/// the reconstruction filter reaches (a tent filter's samples fall up to radius - 1/2 pixel
+/// outside it). From a regular grid of rays_per_side² rays per pixel (geometry, deterministic).
+struct CameraSights {
+    std::vector<char> front_of;  ///< per shape: some ray meets the side its shading normal faces
+    /// How many pixels' worth of rays meet the back of a shape whose BSDF does not scatter from
+    /// below (black in RGB; the side by the shading normal, as the path tracer has it). A few
+    /// rays meet one in any view of a closed mesh: along a smooth-shaded silhouette the normal
+    /// turns away from faces the camera sees, and a ray may slip between two triangles.
+    float black_back_pixels = 0.f;
+    bool nothing = false;  ///< some ray hits nothing
+};
+CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height,
+                           int rays_per_side = 8);
+
 /// The fraction of each pixel whose camera ray first hits each shape of `shapes`, from a regular
 /// grid of rays_per_side² rays per pixel (geometry, deterministic): width × height × shapes.size()
 /// values, the shapes' in their order per pixel. A shape of -1 counts the rays that hit nothing.

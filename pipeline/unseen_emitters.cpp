@@ -46,37 +46,30 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit, const Scene* training_view)
         throw std::runtime_error(fit.dir + ": the -D overrides change the scene's shapes (" +
                                  std::to_string(scene.shapes.size()) + " against " +
                                  std::to_string(seen_from.shapes.size()) + " as fitted)");
-    std::vector<int> candidates;  // the area emitters' shapes, then -1: rays that hit nothing
-    std::vector<Eigen::Array3f> radiance;
-    for (const Emitter& e : scene.emitters)
-        if (!e.is_environment() && e.shape >= 0) {
-            candidates.push_back(e.shape);
-            radiance.push_back(e.radiance_rgb);
-        }
-    candidates.push_back(-1);
-    radiance.push_back(environment_radiance(scene));
     // At least 256 rays across the narrower side: on a latent of a few pixels, 8 × 8 per pixel
     // could step over a gap between a wall and the view's edge that the render's samples find.
     const int w = fit.latent_width, h = fit.latent_height, rays = std::max(8, (255 + std::min(w, h)) / std::min(w, h));
-    const std::vector<float> seen = render_shape_coverage(seen_from, w, h, candidates, rays);
+    const CameraSights sights = camera_sights(seen_from, SceneSpectra<3>::from_description(seen_from), w, h, rays);
     std::unique_ptr<Vae> vae;
-    for (size_t s = 0; s < candidates.size(); ++s) {
-        bool any = false;
-        for (size_t p = 0; p < size_t(w) * h && !any; ++p) any = seen[p * candidates.size() + s] > 0.f;
-        if (any) continue;
+    auto look_of = [&](const Eigen::Array3f& radiance) {
         float rgb[3];
-        for (int k = 0; k < 3; ++k) rgb[k] = display_value(radiance[s][k], fit.ref_tone);
+        for (int k = 0; k < 3; ++k) rgb[k] = display_value(radiance[k], fit.ref_tone);
         if (!vae) vae = open_vae(fit.vae);
-        std::vector<float> look = flat_colour_latent(*vae, rgb);
-        if (candidates[s] < 0) {
-            const bool black = rgb[0] == 0.f && rgb[1] == 0.f && rgb[2] == 0.f;  // no environment
-            const float zero[3] = {0.f, 0.f, 0.f};
-            m_black = black ? look : flat_colour_latent(*vae, zero);
-            m_environment = std::move(look);
-        } else {
-            m_shapes.push_back(candidates[s]);
-            m_looks.push_back(std::move(look));
+        return flat_colour_latent(*vae, rgb);
+    };
+    // an emitter seen only from behind was never fitted as it looks: its look is its emitting side's
+    for (const Emitter& e : scene.emitters)
+        if (!e.is_environment() && e.shape >= 0 && !sights.front_of[size_t(e.shape)]) {
+            m_shapes.push_back(e.shape);
+            m_looks.push_back(look_of(e.radiance_rgb));
         }
+    if (!sights.nothing) m_environment = look_of(environment_radiance(scene));
+    // b̃ was fitted to what paths that end in the background brought back; a view whose black
+    // backs are not worth a latent pixel fitted it to none, and RGB shows them black, whatever
+    // the environment. (cbox-specular's training view: 14 rays of ~10⁶, on its spheres' rims.)
+    if (sights.black_back_pixels < 1.f) {
+        const bool environment_black = m_environment && (environment_radiance(scene) == 0.f).all();
+        m_black = environment_black ? *m_environment : look_of(Eigen::Array3f::Zero());
     }
 }
 
@@ -85,7 +78,7 @@ void UnseenEmitters::show(LatentTerms<kLatentChannels>& terms, ToneCurve tone, s
     terms.look_of_nothing = -1;
     terms.look_of_black = -1;
     terms.looks.clear();
-    if (!on || (m_shapes.empty() && !m_environment)) return;
+    if (!on || (m_shapes.empty() && !m_environment && !m_black)) return;
     auto add = [&](const std::vector<float>& look) {
         Spectrum<kLatentChannels> x;
         for (int k = 0; k < kLatentChannels; ++k) x[k] = tone_inverse(tone, look[k]);

@@ -1,8 +1,10 @@
 // AOVs against geometry: a camera looking straight down at a plane sees its normal and the
 // analytic distance h / cos(angle of the pixel's ray).
 #include "integrators/aov.h"
+#include "integrators/path.h"
 #include "scene_fixtures.h"
 #include <gtest/gtest.h>
+#include <algorithm>
 #include <cmath>
 
 using namespace lpt;
@@ -47,13 +49,12 @@ constexpr float kEdgeFov = 40.f;
 float edge_scene_pixel() { return 2.f * std::tan(0.5f * kEdgeFov * kPi / 180.f) / 8.f; }
 
 /// An emissive rectangle covering world x >= edge (z = 0, facing up) under a camera looking
-/// straight down from height 1 at an 8 × 8 film; nothing else.
-Scene emitter_edge_scene(float edge) {
+/// straight down from height 1 at an 8 × 8 film with `filter`; nothing else.
+Scene emitter_edge_scene(float edge, const std::string& filter = "box") {
     auto s = [](float v) { return std::to_string(v); };
     std::string json = R"({
       "camera": {"fov": )" +
-                       s(kEdgeFov) +
-                       R"(, "width": 8, "height": 8, "filter": {"type": "box"},
+                       s(kEdgeFov) + R"(, "width": 8, "height": 8, "filter": {"type": ")" + filter + R"("},
                  "to_world": {"lookat": {"origin": [0,0,1], "target": [0,0,0], "up": [0,1,0]}}},
       "materials": {"black": {"type": "diffuse", "reflectance": 0}},
       "shapes": [{"id": "light", "type": "rectangle", "material": "black",
@@ -101,4 +102,63 @@ TEST(Aov, EmitterCellsPlaceTheEdgeInsideThePixel) {
                 }
             }
     }
+}
+
+// What the camera meets reaches as far as its samples do: an emitter a quarter of a pixel past the
+// film's edge is met through a tent filter (radius 1: samples fall up to half a pixel outside)
+// and not through a box filter. The renderer agrees: its image of the tent-filtered view is lit
+// at that edge, the box-filtered one is black.
+TEST(Aov, CameraSightsReachAsFarAsThePixelFilter) {
+    const float past_the_edge = 4.25f * edge_scene_pixel();  // the film spans ±4 pixels
+    for (const std::string filter : {"tent", "box"}) {
+        const Scene scene = emitter_edge_scene(past_the_edge, filter);
+        const CameraSights sights = camera_sights(scene, SceneSpectra<3>::from_description(scene), 8, 8);
+        const bool reaches = filter == "tent";
+        EXPECT_EQ(sights.front_of.at(0) != 0, reaches) << filter;
+        EXPECT_TRUE(sights.nothing) << filter;
+        EXPECT_EQ(sights.black_back_pixels, 0.f) << filter;
+        RenderOptions opt = RenderOptions::from_scene(scene);
+        opt.spp = 64;
+        const std::vector<float> image = render_path<3>(scene, SceneSpectra<3>::from_description(scene), opt).develop();
+        float brightest = 0.f;
+        for (float v : image) brightest = std::max(brightest, v);
+        EXPECT_EQ(brightest > 0.f, reaches) << filter << ": the render's samples";
+    }
+}
+
+// The sides are the path tracer's: the same rectangle turned over shows the camera its black back.
+TEST(Aov, CameraSightsTellAnEmittersBackFromItsFront) {
+    Scene scene = emitter_edge_scene(-10.f);  // fills the film
+    const CameraSights front = camera_sights(scene, SceneSpectra<3>::from_description(scene), 8, 8);
+    EXPECT_TRUE(front.front_of.at(0));
+    EXPECT_EQ(front.black_back_pixels, 0.f);
+    EXPECT_FALSE(front.nothing);
+    scene.camera.world_from_camera = Transform::look_at(Vec3f(0, 0, -1), Vec3f(0, 0, 0), Vec3f(0, 1, 0));  // from below
+    scene.build();
+    const CameraSights back = camera_sights(scene, SceneSpectra<3>::from_description(scene), 8, 8);
+    EXPECT_FALSE(back.front_of.at(0));
+    EXPECT_EQ(back.black_back_pixels, 64.f) << "the whole film, every ray";
+    EXPECT_FALSE(back.nothing);
+}
+
+// A smooth-shaded sphere seen from outside shows no back worth a pixel, although along its
+// silhouette the interpolated shading normal turns away from faces the camera sees (and a ray
+// may slip between two triangles to the far side's inside); from inside, it shows its back.
+TEST(Aov, CameraSightsSeeNoBackOnASpheresSilhouette) {
+    const std::string json = R"({
+      "camera": {"fov": 40, "width": 8, "height": 8, "filter": {"type": "box"},
+                 "to_world": {"lookat": {"origin": [0,0,4], "target": [0,0,0], "up": [0,1,0]}}},
+      "materials": {"m": {"type": "diffuse", "reflectance": 0.5}},
+      "shapes": [{"id": "ball", "type": "sphere", "material": "m"}]
+    })";
+    Scene scene = load_scene(test::write_temp_file("sphere_sights.json", json));
+    const CameraSights outside = camera_sights(scene, SceneSpectra<3>::from_description(scene), 8, 8, 32);
+    EXPECT_TRUE(outside.front_of.at(0));
+    EXPECT_TRUE(outside.nothing);
+    EXPECT_GT(outside.black_back_pixels, 0.f) << "the silhouette's shading normals: else this tests nothing";
+    EXPECT_LT(outside.black_back_pixels, 0.25f);
+    scene.camera.world_from_camera = Transform::look_at(Vec3f(0, 0, 0.5f), Vec3f(0, 0, 0), Vec3f(0, 1, 0));
+    const CameraSights inside = camera_sights(scene, SceneSpectra<3>::from_description(scene), 8, 8);
+    EXPECT_FALSE(inside.front_of.at(0));
+    EXPECT_NEAR(inside.black_back_pixels, 64.f, 0.5f);
 }

@@ -23,15 +23,19 @@ namespace {
 
 const std::string kBox = std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json";
 
-/// The box with a second light, a quad facing the camera 0.9 units behind the back wall (hidden).
-std::string box_with_a_hidden_light(const std::string& dir) {
+/// The box with a second light, a quad 0.9 units behind the back wall (hidden) facing the camera;
+/// or, `turned_away`, 0.6 units before it, facing the wall: in view, its back to the camera.
+std::string box_with_a_hidden_light(const std::string& dir, bool turned_away = false) {
     std::string text = read_file(kBox);
     const std::string light = R"({ "id": "light", "type": "mesh", "material": "light", "to_world": { "scale": 0.01 },)";
     const size_t at = text.find(light);
     if (at == std::string::npos) throw std::runtime_error("the box's light entry moved: update this test");
     const std::string hidden =
-        R"({ "id": "hidden_light", "type": "mesh", "material": "light", "to_world": { "scale": 0.01 },
-      "positions": [[400, 350, 650], [150, 350, 650], [150, 520, 650], [400, 520, 650]], "indices": [[0, 1, 2, 3]],
+        std::string(R"({ "id": "hidden_light", "type": "mesh", "material": "light", "to_world": { "scale": 0.01 },
+      "positions": )") +
+        (turned_away ? "[[400, 350, 500], [400, 520, 500], [150, 520, 500], [150, 350, 500]]"
+                     : "[[400, 350, 650], [150, 350, 650], [150, 520, 650], [400, 520, 650]]") +
+        R"(, "indices": [[0, 1, 2, 3]],
       "emitter": { "type": "area", "radiance": [17, 12, 4] } },
     )";
     text.insert(at, hidden);
@@ -226,4 +230,42 @@ TEST(UnseenEmitters, BlackBacksTakeBlacksLookNotTheSkys) {
     EXPECT_GT(apart, 0.1f);
     unseen.show(terms, fit.tone, fit.scene->shapes.size(), false);
     EXPECT_EQ(terms.look_of_black, -1);
+}
+
+// An emitter the training view shows only from behind was never fitted as it looks: it is unseen,
+// and the training view has met a black back (the light's), so b̃ was fitted to one and stays.
+TEST(UnseenEmitters, AnEmitterSeenOnlyFromBehindIsUnseen) {
+    if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
+    const std::string dir = test::temp_dir("unseen-behind");
+    const pipeline::FitJob job = small_fit(box_with_a_hidden_light(dir, true), {}, dir);
+    const pipeline::FitFolder fit = pipeline::load_fit_folder(job.out);
+    const int turned = shape_index(*fit.scene, "hidden_light");
+    ASSERT_GE(turned, 0);
+    const std::vector<float> cover = render_shape_coverage(*fit.scene, 16, 16, {turned});
+    ASSERT_GT(*std::max_element(cover.begin(), cover.end()), 0.5f) << "in view, from behind";
+    const pipeline::UnseenEmitters unseen(fit);
+    EXPECT_EQ(unseen.shapes(), std::vector<int>{turned}) << "the box's own light is seen from the front";
+    EXPECT_FALSE(unseen.environment_unseen()) << "the bundled box's view shows the void";
+    EXPECT_FALSE(unseen.black().has_value()) << "the light's back is a black back the training view shows";
+}
+
+// Black backs take black's look whatever the environment: the bundled box's view shows the void
+// (so the environment keeps b̃) but no black back.
+TEST(UnseenEmitters, BlackBacksTakeBlacksLookWhereTheViewShowsTheVoid) {
+    if (!pipeline::vae_present({})) GTEST_SKIP() << "no TAESD3 weights in ../shared";
+    const std::string dir = test::temp_dir("unseen-backs");
+    const pipeline::FitJob job = small_fit(kBox, {}, dir);
+    const pipeline::FitFolder fit = pipeline::load_fit_folder(job.out);
+    const pipeline::UnseenEmitters unseen(fit);
+    EXPECT_TRUE(unseen.empty());
+    EXPECT_FALSE(unseen.environment_unseen());
+    ASSERT_TRUE(unseen.black().has_value());
+    const std::unique_ptr<Vae> vae = pipeline::open_vae(fit.vae);
+    const float black[3] = {0.f, 0.f, 0.f};
+    EXPECT_EQ(*unseen.black(), pipeline::flat_colour_latent(*vae, black));
+    LatentTerms<kLatentChannels> terms;
+    unseen.show(terms, fit.tone, fit.scene->shapes.size(), true);
+    EXPECT_EQ(terms.look_of_nothing, -1);
+    ASSERT_EQ(terms.look_of_black, 0);
+    EXPECT_EQ(terms.looks.size(), 1u);
 }
