@@ -2,8 +2,6 @@
 #include "core/sampler.h"
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
-#include <algorithm>
-#include <cmath>
 
 namespace lpt {
 
@@ -97,10 +95,7 @@ std::vector<float> render_shape_coverage(const Scene& scene, int width, int heig
 CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height,
                            int rays_per_side) {
     const Camera camera = scene.camera.with_resolution(width, height);
-    const float margin = std::max(0.f, camera.filter.radius - 0.5f);
-    const int n = rays_per_side;
-    const int columns = int(std::ceil((float(width) + 2.f * margin) * float(n)));
-    const int rows = int(std::ceil((float(height) + 2.f * margin) * float(n)));
+    const int n = rays_per_side, columns = width * n, rows = height * n;
     std::vector<char> scatters_below(scene.shapes.size());
     for (size_t s = 0; s < scene.shapes.size(); ++s)
         scatters_below[s] = spectra.bsdf_of(scene, int(s)).scatters_from_below();
@@ -114,7 +109,7 @@ CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, i
         set_ftz_daz();
         Tally& mine = tallies.local();
         for (int i = 0; i < columns; ++i) {
-            const Vec2f film(-margin + (float(i) + 0.5f) / float(n), -margin + (float(j) + 0.5f) / float(n));
+            const Vec2f film((float(i) + 0.5f) / float(n), (float(j) + 0.5f) / float(n));
             const Ray r = camera.generate_ray(film);
             const SurfaceInteraction si = scene.intersect(r);
             if (!si.valid()) {

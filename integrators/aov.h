@@ -26,15 +26,16 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
 /// (docs/refiner.md "Emitter cells"). width × height × cells² values, sub-cells row-major.
 std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side = 4);
 
-/// What the camera's rays meet first anywhere they land: on the film, and past its edges as far as
-/// the reconstruction filter reaches (a tent filter's samples fall up to radius - 1/2 pixel
-/// outside it). From a regular grid of rays_per_side² rays per pixel (geometry, deterministic).
+/// What the camera's rays meet first on the film, from a regular grid of rays_per_side² rays per
+/// pixel (geometry, deterministic). The film only, although a tent filter's samples land up to
+/// half a pixel past its edge: a fit's target is encoded from a picture rendered at the VAE's
+/// downsample times the latent resolution, whose samples reach 1/16 of a latent pixel past it.
 struct CameraSights {
     std::vector<char> front_of;  ///< per shape: some ray meets the side its shading normal faces
     /// How many pixels' worth of rays meet the back of a shape whose BSDF does not scatter from
     /// below (black in RGB; the side by the shading normal, as the path tracer has it). A few
-    /// rays meet one in any view of a closed mesh: along a smooth-shaded silhouette the normal
-    /// turns away from faces the camera sees, and a ray may slip between two triangles.
+    /// rays can meet one where no surface turns its back: along a smooth-shaded silhouette the
+    /// normal turns away from faces the camera sees, and a ray may slip between two triangles.
     float black_back_pixels = 0.f;
     bool nothing = false;  ///< some ray hits nothing
 };

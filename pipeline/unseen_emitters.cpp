@@ -65,9 +65,11 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit, const Scene* training_view)
         }
     if (!sights.nothing) m_environment = look_of(environment_radiance(scene));
     // b̃ was fitted to what paths that end in the background brought back; a view whose black
-    // backs are not worth a latent pixel fitted it to none, and RGB shows them black, whatever
-    // the environment. (cbox-specular's training view: 14 rays of ~10⁶, on its spheres' rims.)
-    if (sights.black_back_pixels < 1.f) {
+    // backs are worth less than a latent pixel, or 1/4096 of the view (smooth silhouettes' stray
+    // rays grow with the view: cbox-specular's, 14 rays of ~10⁶, are 0.22 pixels at 128²),
+    // fitted it to none, and RGB shows them black, whatever the environment.
+    const float worth = std::max(1.f, float(w) * float(h) / 4096.f);
+    if (sights.black_back_pixels < worth) {
         const bool environment_black = m_environment && (environment_radiance(scene) == 0.f).all();
         m_black = environment_black ? *m_environment : look_of(Eigen::Array3f::Zero());
     }

@@ -25,10 +25,9 @@ class UnseenEmitters {
 public:
     UnseenEmitters() = default;
     /// The area emitters of `fit`'s scene whose emitting side no camera ray of the training view
-    /// meets, the environment if every one meets a surface, black backs if none meets one, and
-    /// the latent of each (its colour in `fit`'s scene) from the fit's VAE (opened only if there
-    /// are any). Rays are traced wherever the render's samples land: the film and the pixel
-    /// filter's reach past its edges (camera_sights). The training view is
+    /// meets, the environment if every one meets a surface, black backs if too few meet one to
+    /// have been fitted (less than a latent pixel's worth), and the latent of each (its colour in
+    /// `fit`'s scene) from the fit's VAE (opened only if there are any). camera_sights. The training view is
     /// `training_view` when given (the scene as fitted, where `fit` was loaded with -D overrides
     /// that may change what the camera sees), else `fit`'s scene. None when the VAE is not here
     /// (frames are then latents only, nothing decodes them).
@@ -39,8 +38,8 @@ public:
     const std::vector<int>& shapes() const { return m_shapes; }
     bool environment_unseen() const { return m_environment.has_value(); }
     /// Black's latent, which the black backs of one-sided surfaces take where the training view
-    /// shows none (b̃ was then fitted to the background alone; RGB shows them black, not in the
-    /// environment's colour).
+    /// shows too few to have fitted b̃ to them (b̃ was then fitted to the background; RGB shows
+    /// them black, not in the environment's colour).
     const std::optional<std::vector<float>>& black() const { return m_black; }
     /// Gives `terms` (of a scene with `shapes` shapes) the looks, as linear latents under `tone`
     /// (the renderer mixes a look into a pixel in proportion to its rays that meet it, before the
@@ -51,7 +50,7 @@ private:
     std::vector<int> m_shapes;                        ///< the unseen emitters' shapes
     std::vector<std::vector<float>> m_looks;          ///< each one's latent (channels values)
     std::optional<std::vector<float>> m_environment;  ///< the environment's latent, when unseen
-    std::optional<std::vector<float>> m_black;        ///< black's latent, with it
+    std::optional<std::vector<float>> m_black;        ///< black's latent, when backs are unseen
 };
 
 /// The latent of a flat image of display colour `rgb`: the mean over the inner half of a 64²
