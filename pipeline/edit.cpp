@@ -207,8 +207,9 @@ std::string frame_hash(const EditJob& job, const EditSession& session, bool with
     // their edited frames changed: unseen emitters painted (session 41), then rendered in their looks (42)
     if (!session.unseen_emitters().empty() || session.unseen_emitters().environment_unseen())
         add("unseen emitters rendered in their looks");
-    // and where the training view shows none, the black backs of one-sided surfaces take black's
-    // look (session 49: where the void was unseen; session 50: whatever the environment)
+    // and where the training view shows too few to have fitted b̃ to them, the black backs of
+    // one-sided surfaces take black's look (session 49: where the void was unseen; session 50:
+    // whatever the environment)
     if (session.unseen_emitters().black()) add("black backs in black's look");
     char buf[40];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));

@@ -26,11 +26,11 @@ public:
     UnseenEmitters() = default;
     /// The area emitters of `fit`'s scene whose emitting side no camera ray of the training view
     /// meets, the environment if every one meets a surface, black backs if too few meet one to
-    /// have been fitted (less than a latent pixel's worth), and the latent of each (its colour in
-    /// `fit`'s scene) from the fit's VAE (opened only if there are any). camera_sights. The training view is
-    /// `training_view` when given (the scene as fitted, where `fit` was loaded with -D overrides
-    /// that may change what the camera sees), else `fit`'s scene. None when the VAE is not here
-    /// (frames are then latents only, nothing decodes them).
+    /// have been fitted (less than a latent pixel's worth; camera_sights), and the latent of each
+    /// (its colour in `fit`'s scene) from the fit's VAE (opened only if there are any). The
+    /// training view is `training_view` when given (the scene as fitted, where `fit` was loaded
+    /// with -D overrides that may change what the camera sees), else `fit`'s scene. None when the
+    /// VAE is not here (frames are then latents only, nothing decodes them).
     explicit UnseenEmitters(const FitFolder& fit, const Scene* training_view = nullptr);
     /// No unseen area emitter (the environment aside).
     bool empty() const { return m_shapes.empty(); }
