@@ -76,6 +76,14 @@ std::vector<float> without_looks(const pipeline::FitFolder& fit, int w, int h, i
     return toned_sum(render_latent_terms<kLatentChannels>(*fit.scene, fit.model->spectra(), terms, options), fit.tone);
 }
 
+/// Black backs take black's look: the VAE's latent of a flat black image.
+void expect_blacks_look(const pipeline::FitFolder& fit, const pipeline::UnseenEmitters& unseen) {
+    ASSERT_TRUE(unseen.black().has_value());
+    const std::unique_ptr<Vae> vae = pipeline::open_vae(fit.vae);
+    const float black[3] = {0.f, 0.f, 0.f};
+    EXPECT_EQ(*unseen.black(), pipeline::flat_colour_latent(*vae, black));
+}
+
 }  // namespace
 
 TEST(UnseenEmitters, ShapeCoverageIsTheEmitterCellsOfTheOnlyEmitter) {
@@ -215,10 +223,7 @@ TEST(UnseenEmitters, BlackBacksTakeBlacksLookNotTheSkys) {
     const pipeline::FitFolder fit = pipeline::load_fit_folder(job.out);
     const pipeline::UnseenEmitters unseen(fit);
     ASSERT_TRUE(unseen.environment_unseen());
-    ASSERT_TRUE(unseen.black().has_value());
-    const std::unique_ptr<Vae> vae = pipeline::open_vae(fit.vae);
-    const float black[3] = {0.f, 0.f, 0.f};
-    EXPECT_EQ(*unseen.black(), pipeline::flat_colour_latent(*vae, black));
+    ASSERT_NO_FATAL_FAILURE(expect_blacks_look(fit, unseen));
     LatentTerms<kLatentChannels> terms;
     unseen.show(terms, fit.tone, fit.scene->shapes.size(), true);
     ASSERT_GE(terms.look_of_black, 0);
@@ -259,10 +264,7 @@ TEST(UnseenEmitters, BlackBacksTakeBlacksLookWhereTheViewShowsTheVoid) {
     const pipeline::UnseenEmitters unseen(fit);
     EXPECT_TRUE(unseen.empty());
     EXPECT_FALSE(unseen.environment_unseen());
-    ASSERT_TRUE(unseen.black().has_value());
-    const std::unique_ptr<Vae> vae = pipeline::open_vae(fit.vae);
-    const float black[3] = {0.f, 0.f, 0.f};
-    EXPECT_EQ(*unseen.black(), pipeline::flat_colour_latent(*vae, black));
+    ASSERT_NO_FATAL_FAILURE(expect_blacks_look(fit, unseen));
     LatentTerms<kLatentChannels> terms;
     unseen.show(terms, fit.tone, fit.scene->shapes.size(), true);
     EXPECT_EQ(terms.look_of_nothing, -1);
