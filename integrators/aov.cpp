@@ -49,8 +49,8 @@ AovImages render_aovs(const Scene& scene, const SceneSpectra<3>& spectra, int wi
 
 namespace {
 
-/// Calls hit(pixel, sub-cell, first hit) for every camera ray of a regular grid: each pixel split
-/// into cells × cells sub-cells (row-major), rays_per_side² rays in each; rows in parallel.
+/// Calls hit(pixel, sub-cell, ray, first hit) for every camera ray of a regular grid: each pixel
+/// split into cells × cells sub-cells (row-major), rays_per_side² rays in each; rows in parallel.
 template <class Hit>
 void trace_pixel_grid(const Scene& scene, int width, int height, int cells, int rays_per_side, Hit hit) {
     const Camera camera = scene.camera.with_resolution(width, height);
@@ -63,7 +63,8 @@ void trace_pixel_grid(const Scene& scene, int width, int height, int cells, int 
                     for (int j = 0; j < n; ++j)
                         for (int i = 0; i < n; ++i) {
                             Vec2f film(x + (cx + (i + 0.5f) / n) / cells, y + (cy + (j + 0.5f) / n) / cells);
-                            hit(size_t(y) * width + x, cy * cells + cx, scene.intersect(camera.generate_ray(film)));
+                            const Ray ray = camera.generate_ray(film);
+                            hit(size_t(y) * width + x, cy * cells + cx, ray, scene.intersect(ray));
                         }
     });
 }
@@ -73,9 +74,10 @@ void trace_pixel_grid(const Scene& scene, int width, int height, int cells, int 
 std::vector<float> render_emitter_cells(const Scene& scene, int width, int height, int cells, int rays_per_side) {
     const int k = cells * cells;
     std::vector<int> hits(size_t(width) * height * k, 0);
-    trace_pixel_grid(scene, width, height, cells, rays_per_side, [&](size_t p, int cell, const SurfaceInteraction& si) {
-        hits[p * k + cell] += si.valid() && scene.shapes[si.shape].emitter >= 0;
-    });
+    trace_pixel_grid(scene, width, height, cells, rays_per_side,
+                     [&](size_t p, int cell, const Ray&, const SurfaceInteraction& si) {
+                         hits[p * k + cell] += si.valid() && scene.shapes[si.shape].emitter >= 0;
+                     });
     std::vector<float> out(hits.size());
     for (size_t i = 0; i < hits.size(); ++i) out[i] = float(hits[i]) / float(rays_per_side * rays_per_side);
     return out;
@@ -85,17 +87,16 @@ std::vector<float> render_shape_coverage(const Scene& scene, int width, int heig
                                          int rays_per_side) {
     const size_t k = shapes.size();
     std::vector<float> out(size_t(width) * height * k, 0.f);
-    trace_pixel_grid(scene, width, height, 1, rays_per_side, [&](size_t p, int, const SurfaceInteraction& si) {
-        for (size_t s = 0; s < k; ++s)
-            if (si.shape == shapes[s]) out[p * k + s] += 1.f / float(rays_per_side * rays_per_side);
-    });
+    trace_pixel_grid(scene, width, height, 1, rays_per_side,
+                     [&](size_t p, int, const Ray&, const SurfaceInteraction& si) {
+                         for (size_t s = 0; s < k; ++s)
+                             if (si.shape == shapes[s]) out[p * k + s] += 1.f / float(rays_per_side * rays_per_side);
+                     });
     return out;
 }
 
 CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, int width, int height,
                            int rays_per_side) {
-    const Camera camera = scene.camera.with_resolution(width, height);
-    const int n = rays_per_side, columns = width * n, rows = height * n;
     std::vector<char> scatters_below(scene.shapes.size());
     for (size_t s = 0; s < scene.shapes.size(); ++s)
         scatters_below[s] = spectra.bsdf_of(scene, int(s)).scatters_from_below();
@@ -105,23 +106,18 @@ CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, i
         bool nothing = false;
     };
     tbb::combinable<Tally> tallies([&] { return Tally{std::vector<char>(scene.shapes.size(), 0)}; });
-    tbb::parallel_for(0, rows, [&](int j) {
-        set_ftz_daz();
-        Tally& mine = tallies.local();
-        for (int i = 0; i < columns; ++i) {
-            const Vec2f film((float(i) + 0.5f) / float(n), (float(j) + 0.5f) / float(n));
-            const Ray r = camera.generate_ray(film);
-            const SurfaceInteraction si = scene.intersect(r);
-            if (!si.valid()) {
-                mine.nothing = true;
-                continue;
-            }
-            // the path tracer's sides: an emitter's shading normal is its emission normal
-            const bool front = si.sh.n.dot(-r.d) > 0.f;
-            if (front) mine.front_of[size_t(si.shape)] = 1;
-            if (!front && !scatters_below[size_t(si.shape)]) ++mine.black_back_rays;
-        }
-    });
+    trace_pixel_grid(scene, width, height, 1, rays_per_side,
+                     [&](size_t, int, const Ray& r, const SurfaceInteraction& si) {
+                         Tally& mine = tallies.local();
+                         if (!si.valid()) {
+                             mine.nothing = true;
+                             return;
+                         }
+                         // the path tracer's sides: an emitter's shading normal is its emission normal
+                         const bool front = si.sh.n.dot(-r.d) > 0.f;
+                         if (front) mine.front_of[size_t(si.shape)] = 1;
+                         if (!front && !scatters_below[size_t(si.shape)]) ++mine.black_back_rays;
+                     });
     CameraSights all;
     all.front_of.assign(scene.shapes.size(), 0);
     uint64_t black_back_rays = 0;
@@ -130,7 +126,7 @@ CameraSights camera_sights(const Scene& scene, const SceneSpectra<3>& spectra, i
         black_back_rays += t.black_back_rays;
         all.nothing |= t.nothing;
     });
-    all.black_back_pixels = float(double(black_back_rays) / double(n * n));
+    all.black_back_pixels = float(double(black_back_rays) / double(rays_per_side * rays_per_side));
     return all;
 }
 
