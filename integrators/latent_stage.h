@@ -7,6 +7,7 @@
 #include "integrators/path_events.h"
 #include "integrators/wavefront_state.h"
 #include <stdexcept>
+#include <string>
 
 namespace lpt {
 
@@ -16,6 +17,7 @@ public:
     LatentStage(const LatentTerms<N>& terms, PathObserver<N>* observer) : m_terms(terms), m_obs(observer) {
         if (observer && !terms.looks.empty())
             throw std::invalid_argument("LatentTerms::looks in a render with an observer");
+        check_look_indices(terms);
     }
 
     /// A camera ray met `shape` (-1: nothing; an emitter from its emitting side): with a look
@@ -72,9 +74,22 @@ public:
     }
 
 private:
+    /// Every look index names a look or none (-1), checked once here rather than skipped per
+    /// sample: a mismatch is a caller's error, and skipping it would render the fitted terms.
+    static void check_look_indices(const LatentTerms<N>& terms) {
+        auto check = [&](int i, const char* what) {
+            if (i < -1 || (i >= 0 && size_t(i) >= terms.looks.size()))
+                throw std::invalid_argument(std::string("LatentTerms::") + what + " names look " + std::to_string(i) +
+                                            " of " + std::to_string(terms.looks.size()));
+        };
+        for (int i : terms.look_of_shape) check(i, "look_of_shape");
+        check(terms.look_of_nothing, "look_of_nothing");
+        check(terms.look_of_black, "look_of_black");
+    }
+
     /// Scores looks[i] into Ĩa (true), or nothing where i < 0 (false).
     bool score_look(PathState<N>& p, uint32_t slot, int i) const {
-        if (i < 0 || size_t(i) >= m_terms.looks.size()) return false;
+        if (i < 0) return false;
         p.ambient[slot] += ambient_score(p.beta[slot], m_terms.looks[size_t(i)]);
         return true;
     }

@@ -282,3 +282,26 @@ TEST(LatentTerms, CameraRaysMeetingABlackBackScoreTheLookOfBlack) {
     EXPECT_EQ(back, 32);
     EXPECT_EQ(nothing, 32);
 }
+
+// A look index that names no look is the caller's error: the render refuses it before tracing
+// rather than quietly scoring the fitted terms where the look was meant to show.
+TEST(LatentTerms, LookIndicesThatNameNoLookAreRefused) {
+    const Scene scene = plane_edge_scene(-1.f);
+    auto spectra = SceneSpectra<16>::from_description(scene);
+    const LatentTerms<16> t = zero_terms(scene);
+    const S16 v = ramp(1.5f, -2.f);
+    auto render = [&](const LatentTerms<16>& u) { return render_latent_terms<16>(scene, spectra, u, options(scene)); };
+    LatentTerms<16> black = t;
+    black.looks = {v};
+    black.look_of_black = 1;
+    EXPECT_THROW(render(black), std::invalid_argument);
+    LatentTerms<16> nothing = t;  // no looks at all, yet an index
+    nothing.look_of_nothing = 0;
+    EXPECT_THROW(render(nothing), std::invalid_argument);
+    LatentTerms<16> shape = t;
+    shape.looks = {v};
+    shape.look_of_shape.assign(scene.shapes.size(), -2);
+    EXPECT_THROW(render(shape), std::invalid_argument);
+    shape.look_of_shape.assign(scene.shapes.size(), 0);
+    EXPECT_NO_THROW(render(shape));
+}

@@ -71,7 +71,9 @@ pipeline::FitJob small_fit(const std::string& scene, std::map<std::string, std::
 /// looks an EditSession gives its terms.
 std::vector<float> without_looks(const pipeline::FitFolder& fit, int w, int h, int spp, uint64_t seed) {
     LatentTerms<kLatentChannels> terms = fit.model->terms();
-    terms.looks.clear();
+    terms.looks.clear();  // and every index into them, which a render checks
+    terms.look_of_shape.clear();
+    terms.look_of_nothing = terms.look_of_black = -1;
     const RenderOptions options = RenderOptions::from_scene(*fit.scene, w, h, spp, seed);
     return toned_sum(render_latent_terms<kLatentChannels>(*fit.scene, fit.model->spectra(), terms, options), fit.tone);
 }
