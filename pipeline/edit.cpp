@@ -204,13 +204,12 @@ std::string frame_hash(const EditJob& job, const EditSession& session, bool with
         std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp) +
         reference_seed_suffix(job.ref_seed));     // empty for the default seed: keys as before
     if (job.reference) add(kEditedFrameSeedTag);  // edited frames' references changed seeds: score them again
-    // their edited frames changed: unseen emitters painted (session 41), then rendered in their looks (42)
-    if (!session.unseen_emitters().empty() || session.unseen_emitters().environment_unseen())
-        add("unseen emitters rendered in their looks");
-    // and where the training view shows too few to have fitted b̃ to them, the black backs of
-    // one-sided surfaces take black's look (session 49: where the void was unseen; session 50:
-    // whatever the environment)
-    if (session.unseen_emitters().black()) add("black backs in black's look");
+    // Edited frames show looks for what the training view does not (docs/edits.md). The rules
+    // that decide what that is have changed between versions (sessions 41, 42, 49, 50), so the
+    // key names the set itself, not only that there is one: an older frame made under other
+    // rules is rendered again.
+    const std::string looks = session.unseen_emitters().key();
+    if (!looks.empty()) add("looks for: " + looks);
     char buf[40];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
     return buf;

@@ -75,6 +75,15 @@ UnseenEmitters::UnseenEmitters(const FitFolder& fit, const Scene* training_view)
     }
 }
 
+std::string UnseenEmitters::key() const {
+    std::string key;
+    auto add = [&key](const std::string& what) { key += (key.empty() ? "" : " ") + what; };
+    for (int shape : m_shapes) add("shape " + std::to_string(shape));
+    if (m_environment) add("the environment");
+    if (m_black) add("black backs");
+    return key;
+}
+
 void UnseenEmitters::show(LatentTerms<kLatentChannels>& terms, ToneCurve tone, size_t shapes, bool on) const {
     terms.look_of_shape.clear();
     terms.look_of_nothing = -1;

@@ -13,6 +13,7 @@
 #include "latent/latent.h"
 #include "pipeline/fit_folder.h"
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace lpt {
@@ -41,6 +42,10 @@ public:
     /// shows too few to have fitted b̃ to them (b̃ was then fitted to the background; RGB shows
     /// them black, not in the environment's colour).
     const std::optional<std::vector<float>>& black() const { return m_black; }
+    /// What gets a look, as text ("shape 3 the environment black backs"; empty: nothing): edited
+    /// frames' keys record it, so that frames made when other rules decided what is unseen are
+    /// rendered again (pipeline/edit.cpp).
+    std::string key() const;
     /// Gives `terms` (of a scene with `shapes` shapes) the looks, as linear latents under `tone`
     /// (the renderer mixes a look into a pixel in proportion to its rays that meet it, before the
     /// tone curve, as it mixes everything else); with `on` false, takes them away.

@@ -111,6 +111,8 @@ TEST(UnseenEmitters, AHiddenLightBroughtIntoViewLooksLikeItsColour) {
     const pipeline::UnseenEmitters& unseen = session.unseen_emitters();
     const int hidden = shape_index(*session.fit().scene, "hidden_light");
     ASSERT_EQ(unseen.shapes(), std::vector<int>{hidden}) << "the box's own light is seen in training";
+    // edited frames' keys name what has a look (the view shows the void, and no black back)
+    EXPECT_EQ(unseen.key(), "shape " + std::to_string(hidden) + " black backs");
 
     const pipeline::FrameLatents f = session.frame(1, 2, 0);  // moved by 1.5: in front of the back wall
     const std::vector<float> cover = render_shape_coverage(*session.fit().scene, 16, 16, {hidden});
@@ -155,6 +157,8 @@ TEST(UnseenEmitters, ACameraPannedPastTheWallsSeesTheVoidAsBlack) {
         "pan.json", R"({ "frames": 2, "camera": { "orbit": { "azimuth": [0, 40], "pivot": [2.78, 2.73, -8] } } })");
     pipeline::EditSession session(job.out, edits);
     ASSERT_TRUE(session.unseen_emitters().environment_unseen()) << "the box fills its training view";
+    const std::string key = session.unseen_emitters().key();  // (at 25° the box's light is out of view too)
+    EXPECT_EQ(key.substr(key.find("the environment")), "the environment black backs") << key;
     const std::vector<float> training = session.frame(0, 2, 0).latent;  // the scene at rest, first
     EXPECT_EQ(training, pipeline::render_fit_latent(session.fit(), 16, 16, 2, 0));
 
@@ -254,6 +258,7 @@ TEST(UnseenEmitters, AnEmitterSeenOnlyFromBehindIsUnseen) {
     EXPECT_EQ(unseen.shapes(), std::vector<int>{turned}) << "the box's own light is seen from the front";
     EXPECT_FALSE(unseen.environment_unseen()) << "the bundled box's view shows the void";
     EXPECT_FALSE(unseen.black().has_value()) << "the light's back is a black back the training view shows";
+    EXPECT_EQ(unseen.key(), "shape " + std::to_string(turned)) << "another set, another key";
 }
 
 // Black backs take black's look whatever the environment: the bundled box's view shows the void
@@ -272,4 +277,5 @@ TEST(UnseenEmitters, BlackBacksTakeBlacksLookWhereTheViewShowsTheVoid) {
     EXPECT_EQ(terms.look_of_nothing, -1);
     ASSERT_EQ(terms.look_of_black, 0);
     EXPECT_EQ(terms.looks.size(), 1u);
+    EXPECT_EQ(unseen.key(), "black backs");
 }
