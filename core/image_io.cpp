@@ -96,6 +96,7 @@ void write_exr(const std::string& path, const Image& img) {
     Imf::Header header(img.width, img.height);
     header.compression() = Imf::ZIP_COMPRESSION;
     if (img.display) header.insert(kDisplayValuesAttribute, Imf::StringAttribute(kDisplayValues));
+    if (!img.source.empty()) header.insert(kSourceAttribute, Imf::StringAttribute(img.source));
     Imf::FrameBuffer frame;
     const size_t x_stride = sizeof(float) * img.channels, y_stride = x_stride * img.width;
     for (int c = 0; c < img.channels; ++c) {
@@ -152,6 +153,7 @@ Image read_image(const std::string& path) {
     img.channels = info.channels;
     img.channel_names = info.channel_names;
     img.display = info.display_values;
+    img.source = info.source;
     // The header's size is checked before anything is allocated from it.
     try {
         check_image_fits(img.width, img.height, size_t(std::max(img.channels, 1)));

@@ -17,6 +17,10 @@ struct Image {
     /// header (core/image_reader.h kDisplayValuesAttribute) and read_image reads it back, so that
     /// readers which map an EXR's linear values to display ones (metrics, encode) leave these be.
     bool display = false;
+    /// What the pixels were made from, as the writer's fingerprint (a cached reference's scene,
+    /// defines and edit: pipeline/reference.h), kept in an EXR's header (kSourceAttribute) and
+    /// read back; empty: not recorded.
+    std::string source = {};
 };
 
 /// 32-bit float EXR, ZIP-compressed, no time stamp; `path` must end in .exr. Channel names

@@ -14,6 +14,8 @@ namespace lpt {
 /// (already display-mapped, about [0, 1]); files without it hold linear values.
 inline constexpr const char* kDisplayValuesAttribute = "latentpt:values";
 inline constexpr const char* kDisplayValues = "display";
+/// The EXR header attribute that holds Image::source.
+inline constexpr const char* kSourceAttribute = "latentpt:source";
 
 /// An image file's header, as read before any pixel is decoded.
 struct ImageFileInfo {
@@ -23,6 +25,8 @@ struct ImageFileInfo {
     bool is_uint8 = false;  ///< 8-bit samples
     /// The header marks the values as display values (kDisplayValuesAttribute).
     bool display_values = false;
+    /// The header's kSourceAttribute; empty without one.
+    std::string source;
 };
 
 class ImageFileReader {

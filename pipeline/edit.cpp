@@ -1,6 +1,7 @@
 #include "pipeline/edit.h"
 #include "autodiff/fit.h"
 #include "autodiff/loss.h"
+#include "core/fingerprint.h"
 #include "core/image_io.h"
 #include "pipeline/edit_session.h"
 #include "pipeline/emitter_refiner.h"
@@ -110,7 +111,12 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
                                                           job.ref_spp, fit.ref_tone, frame)) +
                    reference_seed_suffix(job.ref_seed)))
                      .string();
-    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, seed, fit.ref_tone, *t.vae, cached,
+    // the scene's defines: the fit's, with the render's -D on top (load_fit_folder's order)
+    std::map<std::string, std::string> defines = fit.manifest.value("defines", std::map<std::string, std::string>{});
+    for (const auto& [key, value] : job.defines) defines[key] = value;
+    const std::string source =
+        unedited ? reference_source(*fit.scene, defines) : reference_source(*fit.scene, defines, job.edits, index);
+    return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, seed, fit.ref_tone, *t.vae, cached, source,
                                     stem + "_reference.png", ref_rgb);
 }
 
@@ -186,11 +192,8 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
 /// workflow, renders its frames again). A frame that shows the training view does not depend on
 /// the edit file: its name in the frame cache leaves the file out (`with_edits` false).
 std::string frame_hash(const EditJob& job, const EditSession& session, bool with_edits) {
-    uint64_t h = 14695981039346656037ULL;
-    auto add = [&h](const std::string& text) {
-        for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
-        h = (h ^ 0xffu) * 1099511628211ULL;  // a separator, so that ("ab", "c") differs from ("a", "bc")
-    };
+    Fingerprint fingerprint;
+    auto add = [&fingerprint](const std::string& text) { fingerprint.add(text); };
     for (const char* file : {"fit.json", "params.json", "refiner.pt"}) {
         const fs::path p = fs::path(job.fitdir) / file;
         add(fs::exists(p) ? read_file(p.string()) : std::string("absent"));
@@ -210,9 +213,7 @@ std::string frame_hash(const EditJob& job, const EditSession& session, bool with
     // rules is rendered again.
     const std::string looks = session.unseen_emitters().key();
     if (!looks.empty()) add("looks for: " + looks);
-    char buf[40];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-    return buf;
+    return fingerprint.hex();
 }
 
 /// The first line of frame_NNNN.done.

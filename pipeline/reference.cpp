@@ -1,4 +1,5 @@
 #include "pipeline/reference.h"
+#include "core/fingerprint.h"
 #include "core/image_io.h"
 #include "pipeline/fit_folder.h"
 #include "core/sampler.h"
@@ -87,10 +88,22 @@ std::string reference_seed_suffix(uint64_t seed) {
     return seed == kReferenceSeed ? std::string() : "_seed" + std::to_string(seed);
 }
 
+std::string reference_source(const Scene& scene, const std::map<std::string, std::string>& defines,
+                             const std::string& edits, int frame) {
+    Fingerprint fingerprint;
+    fingerprint.add(read_file(scene.file));
+    for (const auto& [key, value] : defines) fingerprint.add(key + "=" + value);
+    if (!edits.empty()) {
+        fingerprint.add(read_file(edits));
+        fingerprint.add("frame " + std::to_string(frame));
+    }
+    return "fnv1a64:" + fingerprint.hex();
+}
+
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
-                                            const std::string& save_png, std::vector<float>& display_rgb,
-                                            const Reporter& report) {
+                                            const std::string& source, const std::string& save_png,
+                                            std::vector<float>& display_rgb, const Reporter& report) {
     namespace fs = std::filesystem;
     if (cache_stem.empty())
         return encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
@@ -104,15 +117,21 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
             encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
         fs::create_directories(fs::path(cache_stem).parent_path());
         write_latent_file(latent);
-        write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}, true});
+        write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}, true, source});
         return latent;
     }
     Image cached = read_fit_image(rgb_file, 3, width, height);
-    if (!cached.display) {
+    if (!cached.source.empty() && cached.source != source)
+        throw std::runtime_error(rgb_file + ": a cached reference of another scene, -D defines or edit sequence (" +
+                                 cached.source + ", this one " + source + " of " + scene.file +
+                                 "): give each scene its own cache folder, or delete the file to trace it again");
+    if (!cached.display || cached.source.empty()) {
         // Written before EXRs carried the display mark (43b57c8): the same display values, unmarked,
-        // which `metrics` would read as linear and map twice. Marked in place, pixels unchanged;
-        // a cache this process may only read (another user's folder) stays as it is.
+        // which `metrics` would read as linear and map twice; or before they recorded their source
+        // (taken to be this one's, as it was then). Marked in place, pixels unchanged; a cache this
+        // process may only read (another user's folder) stays as it is.
         cached.display = true;
+        cached.source = source;
         try {
             write_exr(rgb_file, cached);
         } catch (const std::exception&) {}

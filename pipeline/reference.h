@@ -2,6 +2,7 @@
 #pragma once
 #include "pipeline/progress.h"
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -58,16 +59,26 @@ uint64_t edited_frame_seed(uint64_t ref_seed, int frame);
 /// kReferenceSeed, so caches written before the option keep their names).
 std::string reference_seed_suffix(uint64_t seed);
 
+/// What a traced reference shows, as a fingerprint: the text of `scene`'s file (not of the
+/// meshes and textures it names), the -D `defines` it was loaded with, and for an edited frame
+/// the edit file's text and the frame's index (`edits` empty: the training view). A reference
+/// cache's names say how a frame was traced, not what of: this tells a cached frame of another
+/// scene or sequence from this one's. The sampler is left out: another one's trace is as good.
+std::string reference_source(const Scene& scene, const std::map<std::string, std::string>& defines,
+                             const std::string& edits = {}, int frame = -1);
+
 /// encoded_reference_of through a cache: `cache_stem`.exr holds the display RGB and
 /// `cache_stem`_latent.exr its encoding. A cached reference is read (and re-encoded only when its
 /// latent file is missing); a missing one is traced and both files written, latent first, each
 /// atomically, so several jobs (an experiment's fits and edit sequences) trace a reference once
 /// and encode it once. An empty `cache_stem` caches nothing. `display_rgb` receives the display
-/// image and `save_png` (if not empty) a picture of it. A cached EXR without the display mark
-/// (written before EXRs had one) is rewritten with it, its pixels unchanged.
+/// image and `save_png` (if not empty) a picture of it. The RGB file records `source`
+/// (reference_source) in its header; a cached one that records another throws, naming the file
+/// (two scenes or sequences of one name sharing a cache folder). A cached EXR without the display
+/// mark or the source (written before EXRs had them) is rewritten with them, its pixels unchanged.
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
-                                            const std::string& save_png, std::vector<float>& display_rgb,
-                                            const Reporter& report = {});
+                                            const std::string& source, const std::string& save_png,
+                                            std::vector<float>& display_rgb, const Reporter& report = {});
 
 }  // namespace lpt::pipeline

@@ -25,6 +25,7 @@ public:
             base == OIIO::TypeDesc::FLOAT || base == OIIO::TypeDesc::HALF || base == OIIO::TypeDesc::DOUBLE;
         m_info.is_uint8 = base == OIIO::TypeDesc::UINT8;
         m_info.display_values = spec.get_string_attribute(kDisplayValuesAttribute) == kDisplayValues;
+        m_info.source = spec.get_string_attribute(kSourceAttribute);
     }
     const ImageFileInfo& info() const override { return m_info; }
     void read_float(float* out) override { read(OIIO::TypeDesc::FLOAT, out); }

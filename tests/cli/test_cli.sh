@@ -247,6 +247,21 @@ if [ -d "$shared/models/taesd3" ]; then
     check cmp "$out/ed2/metrics.csv" "$out/ed2u/metrics.csv"
     check sh -c "oiiotool --info -v '$f1' | grep -q '^ *latentpt:values: \"display\"'"
     check cmp "$out/marked.exr" "$f1"
+    # Cached references record what they show (scene text, -D, edit file and frame): another
+    # sequence of the same name, or another scene in the same folder, is refused, naming the
+    # file; a cache from before the record is read as before and given it in place.
+    check sh -c "oiiotool --info -v '$f1' | grep -q '^ *latentpt:source: \"fnv1a64:'"
+    mkdir -p "$out/other"
+    printf '{"frames": 2, "shapes": [{"id": "light", "translate": [[0,0,0],[0.2,0,0]]}]}' > "$out/other/move.json"
+    expect_error "move_16x16_2spp_clip_frame_0001_own_seed.exr: a cached reference of another scene" "$bin" render "$out/enc" --edit "$out/other/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2o"
+    sed 's/"reflectance": \[0.63, 0.065, 0.05\]/"reflectance": [0.05, 0.065, 0.63]/' "$scene" > "$out/other/scene.json"
+    check sh -c "! cmp -s '$scene' '$out/other/scene.json'"
+    expect_error "training_16x16_4spp_clip.exr: a cached reference of another scene" "$bin" fit "$out/other/scene.json" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q --no-refiner --reference-cache "$out/trefs" --out "$out/encc3"
+    oiiotool "$out/marked.exr" --eraseattrib "latentpt:source" -o "$f1"
+    check sh -c "! oiiotool --info -v '$f1' | grep -q '^ *latentpt:source: '"
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2s"
+    check cmp "$out/ed2/metrics.csv" "$out/ed2s/metrics.csv"
+    check cmp "$out/marked.exr" "$f1"
     # Another --ref-seed: independent references of the same frames under their own cache names
     # (the edited frame's and the training view's), the default seed's files untouched.
     cp -r "$out/refs" "$out/refs_before"
