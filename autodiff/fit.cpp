@@ -131,7 +131,10 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
     std::optional<PathRecords> records;
     auto t0 = std::chrono::steady_clock::now();
     double seconds_before = state.history.empty() ? 0.0 : state.history.back().seconds;
-    for (int it = state.next_iteration; it < o.iterations; ++it) {
+    // A fit that stopped early stays stopped when resumed (killed in its refiner stage, say):
+    // its state says so, and one more step would change what it returns.
+    const bool stopped = o.patience > 0 && state.bad_updates >= o.patience;
+    for (int it = stopped ? o.iterations : state.next_iteration; it < o.iterations; ++it) {
         const RenderOptions ro = iteration_options(model, o, width, height, K > 0 ? it - it % K : it);
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
         std::vector<float> linear;

@@ -134,6 +134,26 @@ TEST(Fit, ResumedFitEndsBitIdentical) { expect_resume_bit_identical(0, 10); }
 
 TEST(Fit, ResumedFitWithStoredPathsEndsBitIdentical) { expect_resume_bit_identical(4, 12); }
 
+// A fit that stopped early and is resumed from its state (a run killed after stage 1) takes no
+// further step: it returns what the uninterrupted fit returned.
+TEST(Fit, AnEarlyStoppedFitStaysStoppedWhenResumed) {
+    Scene ts = cornell();
+    LatentModel truth(ts, Parameterisation::Paper, 1);
+    const std::vector<float> target = render_toned(truth, target_options(ts, 16, 7), ToneCurve::Clip);
+    Scene s = cornell();
+    LatentModel m(s, Parameterisation::Paper, 2);
+    FitOptions o = fit_options(30);
+    o.patience = 1;
+    o.min_delta = 1e9f;  // only the first update improves: it stops after two iterations
+    const FitState stopped = fit_latent(m, target, kRes, kRes, o);
+    ASSERT_EQ(stopped.history.size(), 2u);
+    const std::vector<float> raw = m.params().raw();
+    const FitState again = fit_latent(m, target, kRes, kRes, o, stopped);
+    EXPECT_EQ(again.history.size(), 2u);
+    EXPECT_EQ(again.next_iteration, stopped.next_iteration);
+    EXPECT_EQ(m.params().raw(), raw);
+}
+
 TEST(Fit, RejectsNonFiniteOrMisshapenTargets) {
     Scene s = cornell();
     LatentModel m(s, Parameterisation::Code, 1);
