@@ -210,7 +210,13 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
         summary.state = load_checkpoint(o.checkpoint_dir, model);
         report.say("resuming at iteration " + std::to_string(summary.state.next_iteration));
     }
+    const size_t steps_before = summary.state.history.size();
     if (!optimise(model, target, o, summary.state, report)) throw Cancelled("fit");
+    // The refiners were trained on the renders of stage 1 as it was; one that took steps now
+    // (started again and killed before its refiners, or given more iterations) makes them stale,
+    // their checkpoints too.
+    const bool stage1_as_before = resume && summary.state.history.size() == steps_before;
+    if (!stage1_as_before) remove_emitter_refiner(job.out);
     report.say(stage1_summary(summary.state, o.patience));
     save_checkpoint(o.checkpoint_dir, model, summary.state);
     summary.latent_width = target.width;
@@ -223,7 +229,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
         RefineJob r = job.refine;
         r.fitdir = job.out;
         r.train.seed = job.options.seed;
-        r.resume = resume;  // a stage 1 started again makes the old refiner checkpoint stale too
+        r.resume = stage1_as_before;
         r.restart_if_changed = job.restart_if_changed;
         summary.refined = run_refine(r, report);
     }

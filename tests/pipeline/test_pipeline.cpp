@@ -106,6 +106,35 @@ TEST(Pipeline, ResumeRefusesOrRestartsACheckpointOfOtherSettings) {
     EXPECT_THROW(pipeline::run_fit(none), std::runtime_error);
 }
 
+// A finished fit rerun with another stage-1 setting starts stage 1 again; killed there and
+// resumed, it must train its refiner again rather than resume the old one's finished checkpoint,
+// which was trained on the old stage 1's renders: it ends as a fresh fit with the new setting.
+TEST(Pipeline, AStage1StartedAgainTrainsItsRefinerAgainWhenResumed) {
+    const std::string dir = test::temp_dir("pipeline-stale-refiner");
+    auto with_refiner = [](pipeline::FitJob job) {
+        job.refiner = true;
+        job.refine.net.expansion = 1;
+        job.refine.train.iterations = 4;
+        return job;
+    };
+    pipeline::FitJob job = with_refiner(small_fit(dir + "/fit"));
+    const pipeline::FitSummary old = pipeline::run_fit(job);
+    job.options.emission_decay = 0.5f;
+    job.resume = true;
+    job.restart_if_changed = true;
+    EXPECT_THROW(pipeline::run_fit(job, cancel_after(20)), pipeline::Cancelled);  // in stage 1
+    const pipeline::FitSummary resumed = pipeline::run_fit(job);
+    pipeline::FitJob fresh = with_refiner(small_fit(dir + "/fresh"));
+    fresh.options.emission_decay = 0.5f;
+    const pipeline::FitSummary scratch = pipeline::run_fit(fresh);
+    ASSERT_TRUE(old.refined && resumed.refined && scratch.refined);
+    const std::vector<RefinerRecord>& got = resumed.refined->result.history;
+    ASSERT_EQ(got.size(), 4u);
+    EXPECT_NE(got.back().loss, old.refined->result.history.back().loss) << "the old refiner was resumed";
+    EXPECT_EQ(got.back().loss, scratch.refined->result.history.back().loss);
+    EXPECT_EQ(read_file(job.out + "/params.json"), read_file(fresh.out + "/params.json"));
+}
+
 TEST(Pipeline, ACheckpointFromBeforeASettingExistedResumesAtItsOldValueOnly) {
     // settings.json written before --emitter-response-decay existed has no key for it: such a
     // checkpoint was made with μ = 0, so μ = 0 resumes it and any other μ is refused by name.
