@@ -21,11 +21,16 @@ namespace lpt {
 
 namespace fs = std::filesystem;
 
+std::string writer_tag() {
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+    return std::string(host) + "-" + std::to_string(::getpid());
+}
+
 namespace {
 std::string temp_path_for(const std::string& path) {
     fs::path p(path);
-    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + p.extension().string()))
-        .string();
+    return (p.parent_path() / ("." + p.stem().string() + ".tmp" + writer_tag() + p.extension().string())).string();
 }
 
 /// Runs `write(tmp)` on a temporary file beside `path` and renames it over `path` once complete;
@@ -175,14 +180,17 @@ std::string read_file(const std::string& path) {
 }
 
 void write_text_atomic(const std::string& path, const std::string& contents) {
-    if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
-    std::string tmp = temp_path_for(path);
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        out << contents;
-        if (!out) throw std::runtime_error(path + ": cannot write file");
-    }
-    fs::rename(tmp, path);
+    write_atomically(
+        path,
+        [&](const std::string& tmp) {
+            std::ofstream out(tmp, std::ios::binary);
+            out << contents;
+            // short contents reach the disk only when the stream is flushed: a full disk shows
+            // there, and a file cut short must not be renamed into place
+            out.close();
+            if (!out) throw std::runtime_error("the write did not complete");
+        },
+        "file");
 }
 
 void copy_file_atomic(const std::string& from, const std::string& to) {

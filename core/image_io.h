@@ -35,8 +35,12 @@ void write_png_display(const std::string& path, const Image& img);
 Image read_image(const std::string& path);
 /// The whole file as bytes; throws SceneError(path, "", "cannot open file") if it cannot be read.
 std::string read_file(const std::string& path);
-/// Writes `contents` to path atomically (temp + rename).
+/// Writes `contents` to path atomically (temp + rename); a write that does not complete (a full
+/// disk) throws naming `path` and leaves `path` as it was.
 void write_text_atomic(const std::string& path, const std::string& contents);
+/// "<host>-<pid>": what this process's temporary files beside a shared output carry, so that no
+/// two processes, on one node or on several sharing a file system, ever write one file.
+std::string writer_tag();
 /// Copies the file `from` to `to` atomically (temp + rename), replacing `to`.
 void copy_file_atomic(const std::string& from, const std::string& to);
 

@@ -2,7 +2,6 @@
 #include "core/image_io.h"
 #include <filesystem>
 #include <sstream>
-#include <unistd.h>
 
 namespace lpt::pipeline {
 
@@ -14,14 +13,6 @@ namespace {
 /// (CachedFrame::suffixes), its scores after it.
 std::string index_path(const std::string& dir, const std::string& key, const std::string& name) {
     return (fs::path(dir) / (key + "_" + name + ".frame")).string();
-}
-
-/// Each writer's files carry its host and process, so that two jobs keeping the same frame at once
-/// never write one file: the index renamed last names one writer's whole set.
-std::string writer_tag() {
-    char host[256] = {};
-    if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
-    return std::string(host) + "-" + std::to_string(::getpid());
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Image files: multi-channel latent EXRs round-trip in channel order (EXR sorts channels by
 // name), also when another tool named them C0..C15 without padding; writes are atomic; the mark
-// of display values round-trips.
+// of display values and the writer's source round-trip.
 #include "core/image_io.h"
 #include "test_util.h"
 #include <gtest/gtest.h>
@@ -39,6 +39,26 @@ TEST(ImageIo, DisplayValuesMarkRoundTrips) {
         EXPECT_EQ(back.display, display);
         EXPECT_EQ(back.data, img.data);
     }
+    img.source = "fnv1a64:0123456789abcdef";  // a writer's fingerprint (pipeline/reference.h)
+    write_exr(dir + "/source.exr", img);
+    EXPECT_EQ(read_image(dir + "/source.exr").source, img.source);
+    EXPECT_EQ(read_image(dir + "/linear.exr").source, "");
+}
+
+// A text write that cannot complete (the disk full when the stream is flushed, here /dev/full
+// standing in for the temporary file) throws naming the file and leaves the old file whole: a
+// .done cut short must never be renamed into place.
+TEST(ImageIo, ATextWriteThatCannotCompleteLeavesTheOldFile) {
+    namespace fs = std::filesystem;
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    const std::string path = test::write_temp_file("io-full/frame.done", "key old\nrow\n");
+    const fs::path tmp = fs::path(path).parent_path() / (".frame.tmp" + writer_tag() + ".done");
+    fs::remove(tmp);
+    fs::create_symlink("/dev/full", tmp);
+    test::expect_error_naming<std::runtime_error>([&] { write_text_atomic(path, "key new\nrow\n"); },
+                                                  {path, "did not complete"}, "a write to a full disk succeeded");
+    EXPECT_EQ(read_file(path), "key old\nrow\n");
+    EXPECT_FALSE(fs::is_symlink(tmp)) << "the temporary is removed";
 }
 
 namespace {
