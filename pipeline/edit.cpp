@@ -191,7 +191,7 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
 /// --resume skips a frame only if the same fit and settings made it (a refitted fit, rerun by a
 /// workflow, renders its frames again). A frame that shows the training view does not depend on
 /// the edit file: its name in the frame cache leaves the file out (`with_edits` false).
-std::string frame_hash(const EditJob& job, const EditSession& session, bool with_edits) {
+std::string frame_hash(const EditJob& job, const EditSession& session, const Tools& tools, bool with_edits) {
     Fingerprint fingerprint;
     auto add = [&fingerprint](const std::string& text) { fingerprint.add(text); };
     for (const char* file : {"fit.json", "params.json", "refiner.pt"}) {
@@ -207,6 +207,9 @@ std::string frame_hash(const EditJob& job, const EditSession& session, bool with
         std::to_string(job.seed) + " reference " + std::to_string(job.reference) + " " + std::to_string(job.ref_spp) +
         reference_seed_suffix(job.ref_seed));     // empty for the default seed: keys as before
     if (job.reference) add(kEditedFrameSeedTag);  // edited frames' references changed seeds: score them again
+    // scores made without LPIPS weights leave its cell empty, which means would quietly skip:
+    // weights installed later score those frames again (absent: keys as before)
+    if (job.reference && !tools.lpips) add("scored without LPIPS");
     // Edited frames show looks for what the training view does not (docs/edits.md). The rules
     // that decide what that is have changed between versions (sessions 41, 42, 49, 50), so the
     // key names the set itself, not only that there is one: an older frame made under other
@@ -217,8 +220,8 @@ std::string frame_hash(const EditJob& job, const EditSession& session, bool with
 }
 
 /// The first line of frame_NNNN.done.
-std::string frame_key(const EditJob& job, const EditSession& session) {
-    return "key " + frame_hash(job, session, true);
+std::string frame_key(const EditJob& job, const EditSession& session, const Tools& tools) {
+    return "key " + frame_hash(job, session, tools, true);
 }
 
 /// The metrics row of a finished frame whose .done carries `key`; nullopt when it was made from
@@ -258,7 +261,7 @@ int render_edits(const EditJob& job, const Reporter& report) {
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
     if (job.frame_step < 1) throw std::invalid_argument("frame step must be at least 1");
     const int count = (last - first) / job.frame_step + 1;
-    const std::string key = frame_key(job, session), training_view_key = frame_hash(job, session, false);
+    const std::string key = frame_key(job, session, tools), training_view_key = frame_hash(job, session, tools, false);
     bool told = false;
     for (int i = first; i <= last; i += job.frame_step) {
         char name[64];

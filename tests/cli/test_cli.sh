@@ -238,6 +238,16 @@ if [ -d "$shared/models/taesd3" ]; then
     # From the cache: the same references, so the same metrics.
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2c"
     check cmp "$out/ed2/metrics.csv" "$out/ed2c/metrics.csv"
+    # Scores made without LPIPS weights leave rgb_lpips empty; with the weights back, --resume
+    # scores those frames again rather than keep the empty cells (which means would skip).
+    mkdir -p "$out/nolpips/models" && ln -sfn "$shared/models/taesd3" "$out/nolpips/models/taesd3"
+    lpips_cells() { awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "rgb_lpips") c = i; next } { print $c }' "$1"; }
+    LATENTPT_SHARED="$out/nolpips" "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 --res 3x3 -q --out "$out/ed_lp"
+    check test "$(lpips_cells "$out/ed_lp/metrics.csv" | grep -c .)" -eq 0
+    if [ -f "$shared/models/lpips/lpips_squeeze_v0.1.safetensors" ]; then
+        "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 --res 3x3 -q --resume --out "$out/ed_lp"
+        check test "$(lpips_cells "$out/ed_lp/metrics.csv" | grep -c '^[0-9]')" -eq 2
+    fi
     # A cache written before EXRs carried the display mark: read as before and marked in place.
     f1="$out/refs/move_16x16_2spp_clip_frame_0001_own_seed.exr"
     cp "$f1" "$out/marked.exr"
