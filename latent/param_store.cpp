@@ -89,13 +89,20 @@ void set_gain_value(const ParamSlice& s, const float* v, float* r) {
 
 void ParamStore::set_value(int i, const float* v) {
     const ParamSlice& s = m_slices[i];
-    float* r = m_raw.data() + s.raw_offset;
+    // Staged: a value refused at some channel leaves every raw parameter as it was.
+    std::vector<float> staged(m_raw.begin() + s.raw_offset, m_raw.begin() + s.raw_offset + s.raw_size());
+    float* r = staged.data();
+    const auto commit = [&] {
+        std::copy(staged.begin(), staged.end(), m_raw.begin() + s.raw_offset);
+        update_values();
+    };
     if (s.map == ParamMap::Gain) {
         set_gain_value(s, v, r);
-        update_values();
+        commit();
         return;
     }
     for (int c = 0; c < s.channels; ++c) {
+        if (!std::isfinite(v[c])) throw std::invalid_argument("parameter '" + s.name + "': value not finite");
         switch (s.map) {
             case ParamMap::Identity:
                 if (v[c] < s.lo || v[c] > s.hi)
@@ -119,7 +126,7 @@ void ParamStore::set_value(int i, const float* v) {
                 break;  // handled above
         }
     }
-    update_values();
+    commit();
 }
 
 void ParamStore::update_values() {

@@ -75,6 +75,23 @@ TEST(ParamStore, SetValueRoundTripsThroughEveryMap) {
     EXPECT_FLOAT_EQ(ps.value(3)[0], largest[0]);
 }
 
+// A value refused at its last channel, or not finite, leaves every raw parameter as it was (it
+// used to write the channels before the bad one: raw and values then disagreed).
+TEST(ParamStore, ARefusedValueLeavesTheRawParameters) {
+    ParamStore ps = make_store();
+    const std::vector<float> before = ps.raw();
+    const float last_bad[4] = {0.1f, 0.5f, 0.75f, 1.5f};
+    for (int s : {0, 1, 2, 3}) {
+        const float* bad = s == 1 ? last_bad : nullptr;
+        const float nan_last[4] = {0.1f, 0.2f, 0.3f, std::nanf("")};
+        EXPECT_THROW(ps.set_value(s, bad ? bad : nan_last), std::invalid_argument) << s;
+        EXPECT_EQ(ps.raw(), before) << s;
+    }
+    const float posneg_bad[4] = {0.1f, 0.2f, 0.3f, 4.f};  // PosNeg parts limited to [0, 1]
+    EXPECT_THROW(ps.set_value(2, posneg_bad), std::invalid_argument);
+    EXPECT_EQ(ps.raw(), before);
+}
+
 TEST(ParamStore, GainReachesBothSignsOfAnAsymmetricRange) {
     ParamStore ps;
     ps.add("a.Le", "Le", ParamMap::Gain, 3, -2.f, 6.f);
