@@ -179,6 +179,24 @@ void validate(const FitJob& job) {
         throw std::invalid_argument("--gate is shadowed or visible, got '" + job.gate + "'");
     if (job.ref_tone != "clip" && job.ref_tone != "reinhard")
         throw std::invalid_argument("--ref-tone is clip or reinhard, got '" + job.ref_tone + "'");
+    // the CLI's own checks, here too for callers without it (latentpt.fit in Python)
+    auto require = [](bool ok, const char* flag, const char* range, double value) {
+        if (ok) return;
+        char v[32];
+        std::snprintf(v, sizeof v, "%g", value);
+        throw std::invalid_argument(std::string("fit ") + flag + " must be " + range + ", got " + v);
+    };
+    const FitOptions& o = job.options;
+    require(o.iterations > 0, "--iterations", "> 0", o.iterations);
+    require(o.spp > 0, "--spp", "> 0", o.spp);
+    require(job.final_spp > 0, "--final-spp", "> 0", job.final_spp);
+    require(o.lr > 0.f && std::isfinite(o.lr), "--lr", "> 0", o.lr);
+    require(o.lr_min >= 0.f && std::isfinite(o.lr_min), "--lr-min", ">= 0", o.lr_min);
+    require(o.lr_period > 0, "--lr-period", "> 0", o.lr_period);
+    require(o.patience >= 0, "--patience", ">= 0", o.patience);
+    require(o.min_delta >= 0.f && std::isfinite(o.min_delta), "--min-delta", ">= 0", o.min_delta);
+    require(o.checkpoint_every >= 0, "--checkpoint-every", ">= 0", o.checkpoint_every);
+    require(o.reuse_paths >= 0, "--reuse-paths", ">= 0", o.reuse_paths);
     for (const auto& [flag, value] : {std::pair{"--emission-decay", job.options.emission_decay},
                                       std::pair{"--emitter-response-decay", job.options.emitter_response_decay}})
         if (!(value >= 0.f) || !std::isfinite(value))

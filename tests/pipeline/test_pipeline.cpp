@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
 #include <map>
 
@@ -133,6 +134,28 @@ TEST(Pipeline, AStage1StartedAgainTrainsItsRefinerAgainWhenResumed) {
     EXPECT_NE(got.back().loss, old.refined->result.history.back().loss) << "the old refiner was resumed";
     EXPECT_EQ(got.back().loss, scratch.refined->result.history.back().loss);
     EXPECT_EQ(read_file(job.out + "/params.json"), read_file(fresh.out + "/params.json"));
+}
+
+// The fit's own checks, not only the CLI's: a caller without it (latentpt.fit in Python) gets an
+// error naming the option rather than a fit at zero gradient or a division by a zero period.
+TEST(Pipeline, FitOptionsOutOfRangeAreRefusedByName) {
+    const pipeline::FitJob good = small_fit(test::temp_dir("pipeline-fit-range") + "/fit");
+    const std::vector<std::pair<std::string, std::function<void(pipeline::FitJob&)>>> cases = {
+        {"--spp", [](pipeline::FitJob& j) { j.options.spp = -3; }},
+        {"--iterations", [](pipeline::FitJob& j) { j.options.iterations = 0; }},
+        {"--final-spp", [](pipeline::FitJob& j) { j.final_spp = 0; }},
+        {"--lr", [](pipeline::FitJob& j) { j.options.lr = std::nanf(""); }},
+        {"--lr-period", [](pipeline::FitJob& j) { j.options.lr_period = 0; }},
+        {"--min-delta", [](pipeline::FitJob& j) { j.options.min_delta = -1.f; }},
+        {"--reuse-paths", [](pipeline::FitJob& j) { j.options.reuse_paths = -1; }},
+    };
+    for (const auto& [flag, spoil] : cases) {
+        pipeline::FitJob job = good;
+        spoil(job);
+        test::expect_error_naming<std::invalid_argument>([&] { pipeline::run_fit(job); }, {flag},
+                                                         "a fit with a bad " + flag + " was accepted");
+    }
+    EXPECT_FALSE(fs::exists(good.out + "/params.json"));
 }
 
 TEST(Pipeline, ACheckpointFromBeforeASettingExistedResumesAtItsOldValueOnly) {
