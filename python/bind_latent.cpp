@@ -6,6 +6,7 @@
 #include "bindings.h"
 #include "pipeline/fit_folder.h"
 #include <pybind11/stl.h>
+#include <mutex>
 
 namespace lpt::python {
 
@@ -17,10 +18,19 @@ struct LatentScene {
     ToneCurve tone = ToneCurve::Clip;
     int width = 0, height = 0;  ///< the default latent resolution
 
+    /// Serialises what reads the model (renders, the adjoint, which also writes its gradients)
+    /// with what changes it (raw, set_value): either may run in another Python thread, the
+    /// renders without the GIL.
+    mutable std::mutex busy;
+
     RenderOptions options(int w, int h, int spp, uint64_t seed) const {
+        if (spp <= 0) throw py::value_error("spp must be > 0, got " + std::to_string(spp));
         return RenderOptions::from_scene(*scene, w > 0 ? w : width, h > 0 ? h : height, spp, seed);
     }
-    size_t floats(const RenderOptions& o) const { return size_t(o.width) * size_t(o.height) * kLatentChannels; }
+    /// A latent image's array shape at `o`: (height, width, 16).
+    static std::vector<py::ssize_t> latent_shape(const RenderOptions& o) {
+        return {o.height, o.width, kLatentChannels};
+    }
     int slice(const std::string& name) const {
         const int i = model->params().find(name);
         if (i < 0) throw py::key_error("no parameter '" + name + "' (LatentScene.slices() lists them)");
@@ -75,10 +85,11 @@ py::array_t<float> render(const LatentScene& ls, int w, int h, int spp, uint64_t
     std::vector<float> img;
     {
         py::gil_scoped_release unlocked;
+        const std::lock_guard<std::mutex> lock(ls.busy);
         img = linear ? render_latent_terms<kLatentChannels>(*ls.scene, ls.model->spectra(), ls.model->terms(), o).sum()
                      : render_toned(*ls.model, o, ls.tone);
     }
-    return to_numpy(std::move(img), {o.height, o.width, kLatentChannels});
+    return to_numpy(std::move(img), LatentScene::latent_shape(o));
 }
 
 /// ∂loss/∂raw for ∂loss/∂(linear latent) of the render with the same options (path replay).
@@ -86,15 +97,17 @@ py::array_t<float> backward_linear(LatentScene& ls,
                                    const py::array_t<float, py::array::c_style | py::array::forcecast>& d, int w, int h,
                                    int spp, uint64_t seed) {
     const RenderOptions o = ls.options(w, h, spp, seed);
-    const std::vector<float> d_image = from_numpy(d, ls.floats(o), "d_latent");
+    const std::vector<float> d_image = from_numpy(d, LatentScene::latent_shape(o), "d_linear");
     ParamStore& ps = ls.model->params();
+    std::vector<float> g;
     {
         py::gil_scoped_release unlocked;
+        const std::lock_guard<std::mutex> lock(ls.busy);
         ps.zero_grad();
         backward_latent(*ls.model, o, d_image);
         ps.backward();
+        g = ps.grad_raw();
     }
-    std::vector<float> g = ps.grad_raw();
     return to_numpy(std::move(g), {py::ssize_t(g.size())});
 }
 
@@ -110,7 +123,7 @@ py::array_t<float> tone_backward(const LatentScene& ls,
                                  const py::array_t<float, py::array::c_style | py::array::forcecast>& x,
                                  const py::array_t<float, py::array::c_style | py::array::forcecast>& d) {
     const std::vector<float> v(x.data(), x.data() + x.size());
-    const std::vector<float> dv = from_numpy(d, v.size(), "d_toned");
+    const std::vector<float> dv = from_numpy(d, std::vector<py::ssize_t>(x.shape(), x.shape() + x.ndim()), "d_toned");
     std::vector<float> out(v.size());
     tone_map_backward(ls.tone, v.data(), dv.data(), out.data(), v.size());
     std::vector<py::ssize_t> shape(x.shape(), x.shape() + x.ndim());
@@ -119,7 +132,7 @@ py::array_t<float> tone_backward(const LatentScene& ls,
 
 void set_raw(LatentScene& ls, const py::array_t<float, py::array::c_style | py::array::forcecast>& raw) {
     ParamStore& ps = ls.model->params();
-    std::vector<float> r = from_numpy(raw, ps.raw().size(), "raw");
+    std::vector<float> r = from_numpy(raw, {py::ssize_t(ps.raw().size())}, "raw");
     // What params.json refuses too (a log-gain that would overflow e^g, docs/params.md (4)).
     for (size_t i = 0; i < ps.slice_count(); ++i) {
         const ParamSlice& s = ps.slice(int(i));
@@ -128,6 +141,8 @@ void set_raw(LatentScene& ls, const py::array_t<float, py::array::c_style | py::
             if (!problem.empty()) throw py::value_error("raw: " + s.name + ": " + problem);
         }
     }
+    py::gil_scoped_release unlocked;  // while a render in another thread finishes
+    const std::lock_guard<std::mutex> lock(ls.busy);
     ps.raw() = std::move(r);
     ls.model->sync();
 }
@@ -142,7 +157,9 @@ py::array_t<float> value_of(const LatentScene& ls, const std::string& name) {
 void set_value(LatentScene& ls, const std::string& name,
                const py::array_t<float, py::array::c_style | py::array::forcecast>& v) {
     const int i = ls.slice(name);
-    const std::vector<float> values = from_numpy(v, size_t(ls.model->params().slice(i).channels), name.c_str());
+    const std::vector<float> values = from_numpy(v, {py::ssize_t(ls.model->params().slice(i).channels)}, name);
+    py::gil_scoped_release unlocked;
+    const std::lock_guard<std::mutex> lock(ls.busy);
     ls.model->params().set_value(i, values.data());
     ls.model->sync();
 }

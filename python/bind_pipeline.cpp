@@ -97,43 +97,63 @@ bool apply_refine_option(pipeline::RefineJob& job, const std::string& k, const p
     return true;
 }
 
-/// Sets the job fields named in `options` (the CLI's option names with underscores).
-void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
+/// Sets the FitJob field that `k` names (fit --<k> with underscores); false when there is none.
+bool apply_fit_option(pipeline::FitJob& job, const std::string& k, const py::handle& value) {
+    FitOptions& o = job.options;
+    if (k == "iterations") o.iterations = value.cast<int>();
+    else if (k == "spp") o.spp = value.cast<int>();
+    else if (k == "seed") o.seed = value.cast<uint64_t>();
+    else if (k == "lr") o.lr = value.cast<float>();
+    else if (k == "lr_min") o.lr_min = value.cast<float>();
+    else if (k == "lr_period") o.lr_period = value.cast<int>();
+    else if (k == "patience") o.patience = value.cast<int>();
+    else if (k == "emission_decay") o.emission_decay = value.cast<float>();
+    else if (k == "emitter_response_decay") o.emitter_response_decay = value.cast<float>();
+    else if (k == "reuse_paths") o.reuse_paths = value.cast<int>();
+    else if (k == "checkpoint_every") o.checkpoint_every = value.cast<int>();
+    else if (k == "tone") o.tone = parse_tone_curve(value.cast<std::string>());
+    else if (k == "final_spp") job.final_spp = value.cast<int>();
+    else if (k == "target") job.target = value.cast<std::string>();
+    else if (k == "encode") job.encode = value.cast<bool>();
+    else if (k == "encode_res") job.encode_res = value.cast<std::string>();
+    else if (k == "ref_spp") job.ref_spp = value.cast<int>();
+    else if (k == "synthetic_res") job.synthetic_res = value.cast<std::string>();
+    else if (k == "param") job.param = value.cast<std::string>();
+    else if (k == "gate") job.gate = value.cast<std::string>();
+    else if (k == "terms") job.terms = value.cast<std::string>();
+    else if (k == "resume") job.resume = value.cast<bool>();
+    else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
+    else if (k == "refiner") job.refiner = value.cast<bool>();
+    else if (k == "sampler") job.sampler = sampler_choice(value.cast<std::string>(), k);
+    else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
+    else if (k == "lpips_dir") job.refine.lpips_dir = value.cast<std::string>();  // fit --lpips-dir
+    else if (k.rfind("refiner_", 0) == 0 && k != "refiner_seed")
+        return apply_refine_option(job.refine, k.substr(8), value, "refiner_");
+    else return false;
+    return true;
+}
+
+/// Applies `options` through `apply` (true: the option exists), each a TypeError naming it
+/// when its value is of the wrong type or it is unknown to `call`.
+template <typename Apply>
+void apply_options(const char* call, const py::dict& options, Apply apply) {
     for (const auto& [key, value] : options) {
         const std::string k = py::str(key);
-        FitOptions& o = job.options;
-        if (k == "iterations") o.iterations = value.cast<int>();
-        else if (k == "spp") o.spp = value.cast<int>();
-        else if (k == "seed") o.seed = value.cast<uint64_t>();
-        else if (k == "lr") o.lr = value.cast<float>();
-        else if (k == "lr_min") o.lr_min = value.cast<float>();
-        else if (k == "lr_period") o.lr_period = value.cast<int>();
-        else if (k == "patience") o.patience = value.cast<int>();
-        else if (k == "emission_decay") o.emission_decay = value.cast<float>();
-        else if (k == "emitter_response_decay") o.emitter_response_decay = value.cast<float>();
-        else if (k == "reuse_paths") o.reuse_paths = value.cast<int>();
-        else if (k == "checkpoint_every") o.checkpoint_every = value.cast<int>();
-        else if (k == "tone") o.tone = parse_tone_curve(value.cast<std::string>());
-        else if (k == "final_spp") job.final_spp = value.cast<int>();
-        else if (k == "target") job.target = value.cast<std::string>();
-        else if (k == "encode") job.encode = value.cast<bool>();
-        else if (k == "encode_res") job.encode_res = value.cast<std::string>();
-        else if (k == "ref_spp") job.ref_spp = value.cast<int>();
-        else if (k == "synthetic_res") job.synthetic_res = value.cast<std::string>();
-        else if (k == "param") job.param = value.cast<std::string>();
-        else if (k == "gate") job.gate = value.cast<std::string>();
-        else if (k == "terms") job.terms = value.cast<std::string>();
-        else if (k == "resume") job.resume = value.cast<bool>();
-        else if (k == "restart_if_changed") job.restart_if_changed = value.cast<bool>();
-        else if (k == "refiner") job.refiner = value.cast<bool>();
-        else if (k == "sampler") job.sampler = sampler_choice(value.cast<std::string>(), k);
-        else if (k == "vae_dir") job.vae.dir = value.cast<std::string>();
-        else if (k == "lpips_dir") job.refine.lpips_dir = value.cast<std::string>();  // fit --lpips-dir
-        else if (k.rfind("refiner_", 0) == 0 && k != "refiner_seed" &&
-                 apply_refine_option(job.refine, k.substr(8), value, "refiner_"))
-            continue;
-        else throw py::type_error("fit() got an unknown option '" + k + "'");
+        bool known = false;
+        try {
+            known = apply(k, value);
+        } catch (const py::cast_error&) {
+            const std::string type = py::str(value.get_type().attr("__name__"));
+            throw py::type_error(std::string(call) + "(): option '" + k + "' cannot be a " + type);
+        }
+        if (!known) throw py::type_error(std::string(call) + "() got an unknown option '" + k + "'");
     }
+}
+
+/// Sets the job fields named in `options` (the CLI's option names with underscores).
+void apply_fit_options(pipeline::FitJob& job, const py::dict& options) {
+    apply_options("fit", options,
+                  [&](const std::string& k, const py::handle& v) { return apply_fit_option(job, k, v); });
 }
 
 py::dict run_fit(const std::string& scene, const std::string& out, const std::map<std::string, std::string>& defines,
@@ -161,10 +181,8 @@ py::dict run_refine(const std::string& fitdir, bool resume, const py::object& pr
     pipeline::RefineJob job;
     job.fitdir = fitdir;
     job.resume = resume;
-    for (const auto& [key, value] : options) {
-        const std::string k = py::str(key);
-        if (!apply_refine_option(job, k, value)) throw py::type_error("refine() got an unknown option '" + k + "'");
-    }
+    apply_options("refine", options,
+                  [&](const std::string& k, const py::handle& v) { return apply_refine_option(job, k, v); });
     const pipeline::Reporter report = reporter(progress, note);
     const pipeline::RefineSummary s = without_gil([&] { return pipeline::run_refine(job, report); });
     return py::module_::import("json").attr("loads")(s.metrics.dump());

@@ -10,6 +10,7 @@ namespace lpt::python {
 namespace {
 
 RenderOptions options_for(const Scene& scene, int spp, int width, int height, uint64_t seed, int max_depth) {
+    if (spp < 0) throw py::value_error("spp must be > 0, or 0 for the scene's own; got " + std::to_string(spp));
     RenderOptions o = RenderOptions::from_scene(scene);
     if (spp > 0) o.spp = spp;
     o.width = width;
@@ -31,11 +32,12 @@ py::array_t<float> render_rgb(const Scene& scene, int spp, int width, int height
 }
 
 py::dict render_aov_images(const Scene& scene, int width, int height, int spp, uint64_t seed) {
+    if (spp <= 0) throw py::value_error("spp must be > 0, got " + std::to_string(spp));
     AovImages a;
     {
         py::gil_scoped_release unlocked;
         a = render_aovs(scene, SceneSpectra<3>::from_description(scene), width > 0 ? width : scene.camera.width,
-                        height > 0 ? height : scene.camera.height, spp, seed);
+                        height > 0 ? height : scene.camera.height, spp, seed, scene.integrator.sampler);
     }
     py::dict d;
     d["normal"] = to_numpy(std::move(a.normal), {a.height, a.width, 3});

@@ -3,6 +3,8 @@
 #include "bindings.h"
 #include "core/error.h"
 #include "pipeline/progress.h"
+#include <cmath>
+#include <string>
 
 namespace lpt::python {
 
@@ -12,12 +14,23 @@ py::array_t<float> to_numpy(std::vector<float>&& data, std::vector<py::ssize_t> 
     return py::array_t<float>(shape, owned->data(), free_when_done);
 }
 
-std::vector<float> from_numpy(const py::array_t<float, py::array::c_style | py::array::forcecast>& a, size_t expected,
-                              const char* what) {
-    if (size_t(a.size()) != expected)
-        throw py::value_error(std::string(what) + ": expected " + std::to_string(expected) + " floats, got " +
-                              std::to_string(a.size()));
-    return std::vector<float>(a.data(), a.data() + a.size());
+namespace {
+std::string shape_text(const std::vector<py::ssize_t>& shape) {
+    std::string text = "(";
+    for (size_t i = 0; i < shape.size(); ++i) text += (i ? ", " : "") + std::to_string(shape[i]);
+    return text + (shape.size() == 1 ? ",)" : ")");
+}
+}  // namespace
+
+std::vector<float> from_numpy(const py::array_t<float, py::array::c_style | py::array::forcecast>& a,
+                              const std::vector<py::ssize_t>& shape, const std::string& what) {
+    const std::vector<py::ssize_t> got(a.shape(), a.shape() + a.ndim());
+    if (got != shape)
+        throw py::value_error(what + ": expected an array of shape " + shape_text(shape) + ", got " + shape_text(got));
+    std::vector<float> v(a.data(), a.data() + a.size());
+    for (size_t i = 0; i < v.size(); ++i)
+        if (!std::isfinite(v[i])) throw py::value_error(what + ": value " + std::to_string(i) + " is not finite");
+    return v;
 }
 
 }  // namespace lpt::python

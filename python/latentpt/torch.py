@@ -6,7 +6,7 @@ moves scene parameters.
     import torch, latentpt, latentpt.torch as lt
     model = latentpt.LatentScene.from_fit("fit-out")
     raw = lt.raw_parameters(model)                # torch.nn.Parameter over every slice
-    opt = torch.optim.Adam([raw], lr=1e-2)
+    opt = torch.optim.SGD([raw], lr=0.1)
     latent = lt.render_latent(model, raw, spp=16, seed=it)   # (h, w, 16), differentiable
 """
 import numpy as np
@@ -24,9 +24,12 @@ class _LatentRender(torch.autograd.Function):
         ctx.model, ctx.raw, ctx.linear = model, raw_np, linear
         ctx.args = (width, height, spp, seed)
         ctx.device, ctx.dtype = raw.device, raw.dtype
-        return torch.from_numpy(model.tone(linear))
+        # on raw's device and in its dtype, as torch functions answer: a loss on the GPU (a
+        # diffusion model's) takes the latent as it is, and gradcheck can run in float64
+        return torch.from_numpy(model.tone(linear)).to(raw.device, raw.dtype)
 
     @staticmethod
+    @torch.autograd.function.once_differentiable
     def backward(ctx, grad_latent):
         model = ctx.model
         model.raw = ctx.raw  # the parameters of the forward pass, whatever happened since
@@ -37,7 +40,9 @@ class _LatentRender(torch.autograd.Function):
 
 def render_latent(model, raw, width=0, height=0, spp=16, seed=0):
     """The tone-mapped latent (height, width, 16) of `model` with raw parameters `raw` (a 1-D
-    tensor laid out as model.raw); 0 = the model's latent resolution. Differentiable in `raw`."""
+    tensor laid out as model.raw), on raw's device and in its dtype (computed in float32 on the
+    CPU); 0 = the model's latent resolution. Differentiable in `raw`, once: the gradient itself
+    is not differentiable."""
     return _LatentRender.apply(raw, model, width, height, spp, seed)
 
 

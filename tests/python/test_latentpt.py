@@ -69,6 +69,54 @@ class LatentTest(unittest.TestCase):
         with self.assertRaises(KeyError):
             self.model.value("no.such")
 
+    def test_misshapen_arrays_bad_values_and_spp_are_refused_and_change_nothing(self):
+        m = self.model
+        w = np.ones((m.height, m.width, 16), np.float32)
+        with self.assertRaisesRegex(ValueError, r"d_linear: expected an array of shape \(8, 8, 16\)"):
+            m.backward_linear(w.transpose(2, 0, 1).copy(), spp=2)  # channels first, as torch users write
+        raw = m.raw.copy()
+        with self.assertRaisesRegex(ValueError, "raw: expected an array of shape"):
+            m.raw = raw.reshape(-1, 1)
+        bad = raw.copy()
+        bad[3] = np.nan
+        with self.assertRaisesRegex(ValueError, "raw: value 3 is not finite"):
+            m.raw = bad
+        v = np.linspace(0.1, 0.5, 16, dtype=np.float32)
+        v[-1] = np.nan  # refused at the last channel: the channels before it stay as they were
+        with self.assertRaises(ValueError):
+            m.set_value("red_wall.bsdf.reflectance", v)
+        np.testing.assert_array_equal(m.raw, raw)
+        for call in (lambda: m.render(spp=0), lambda: m.backward_linear(w, spp=-1),
+                     lambda: m.scene.aovs(spp=0), lambda: m.scene.render(spp=-2)):
+            with self.assertRaisesRegex(ValueError, "spp must be > 0"):
+                call()
+
+    def test_renders_and_parameter_changes_from_several_threads_do_not_race(self):
+        """A render in one thread and raw writes in another: every render is of one raw vector."""
+        m = self.model
+        raws = [m.raw.copy(), m.raw.copy() * 0.5]
+        expected = []
+        for r in raws:
+            m.raw = r
+            expected.append(m.render_linear(spp=2, seed=1))
+        got, stop = [], threading.Event()
+
+        def writer():
+            while not stop.is_set():
+                for r in raws:
+                    m.raw = r
+
+        t = threading.Thread(target=writer)
+        t.start()
+        try:
+            for _ in range(20):
+                got.append(m.render_linear(spp=2, seed=1))
+        finally:
+            stop.set()
+            t.join()
+        for g in got:
+            self.assertTrue(any(np.array_equal(g, e) for e in expected), "a render of half-written parameters")
+
     def check_adjoint(self, m, entries):
         """Raw gradient of a fixed linear functional of the linear latent against central
         differences, at the raw entries `entries` ({slice name: offsets within its raw})."""
@@ -128,6 +176,13 @@ class LatentTest(unittest.TestCase):
         m.raw = raw.detach().numpy()
         expected = m.backward_linear(m.tone_backward(m.render_linear(spp=4, seed=7), w.numpy()), spp=4, seed=7)
         np.testing.assert_allclose(raw.grad.numpy(), expected, rtol=1e-6, atol=1e-9)
+        # float64 parameters give a float64 latent and gradient, as torch functions answer
+        raw64 = lt.raw_parameters(m).detach().double().requires_grad_()
+        latent64 = lt.render_latent(m, raw64, spp=4, seed=7)
+        self.assertEqual(latent64.dtype, torch.float64)
+        (w.double() * latent64).sum().backward()
+        self.assertEqual(raw64.grad.dtype, torch.float64)
+        np.testing.assert_allclose(raw64.grad.numpy(), expected, rtol=1e-5, atol=1e-8)
 
 
 class GuidanceTest(unittest.TestCase):
@@ -255,6 +310,12 @@ class PipelineTest(unittest.TestCase):
                 self.assertTrue(np.isfinite(rgb).all())
             with self.assertRaises(TypeError):
                 latentpt.fit(BOX, cancelled, no_such_option=1)
+            with self.assertRaisesRegex(TypeError, "option 'iterations' cannot be a str"):
+                latentpt.fit(BOX, cancelled, synthetic_res="8x8", iterations="10")
+            for bad, flag in (({"spp": -3}, "--spp"), ({"lr_period": 0}, "--lr-period")):
+                with self.assertRaisesRegex(ValueError, flag):  # the fit's own checks, not only the CLI's
+                    latentpt.fit(BOX, os.path.join(d, "never"), synthetic_res="8x8", refiner=False, **bad)
+            self.assertFalse(os.path.exists(os.path.join(d, "never", "params.json")))
 
 
 class SamplerTest(unittest.TestCase):
@@ -272,6 +333,8 @@ class SamplerTest(unittest.TestCase):
         self.assertFalse(np.array_equal(sobol.render(**args), by_file))  # the other scene kept its own
         sobol.sampler = "independent"
         np.testing.assert_array_equal(sobol.render(**args), by_file)
+        aovs = dict(spp=2, width=16, height=16, seed=3)  # the AOVs' samples follow it too
+        self.assertFalse(np.array_equal(latentpt.Scene(BOX).aovs(**aovs)["normal"], chosen.aovs(**aovs)["normal"]))
         with self.assertRaises(ValueError):
             latentpt.Scene(BOX, sampler="halton")
         with self.assertRaises(ValueError):
