@@ -34,6 +34,7 @@ const char* const kMetricColumns = "latent_mse,latent_psnr,latent_dssim,rgb_mse_
 struct Tools {
     std::unique_ptr<Vae> vae;
     std::unique_ptr<Lpips> lpips;
+    std::string encoder;  ///< with --reference: the VAE's vae_encoder_fingerprint (cached latents record it)
 };
 
 Tools open_tools(const EditJob& job, const EditSession& session, const Reporter& report) {
@@ -50,6 +51,7 @@ Tools open_tools(const EditJob& job, const EditSession& session, const Reporter&
         report.say("note: " + (fs::path(job.fitdir) / "refiner.pt").string() + " not found: frames are not refined");
     if (have_vae) t.vae = open_vae(fit.vae);
     if (job.reference && have_vae) {
+        t.encoder = vae_encoder_fingerprint(fit.vae);
         const std::string lpips_dir = default_lpips_dir("");
         if (fs::exists(fs::path(lpips_dir) / "lpips_squeeze_v0.1.safetensors")) t.lpips = Lpips::load(lpips_dir);
         else report.say("note: no LPIPS weights at " + lpips_dir + ": rgb_lpips left empty");
@@ -117,7 +119,7 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
     const std::string source =
         unedited ? reference_source(*fit.scene, defines) : reference_source(*fit.scene, defines, job.edits, index);
     return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, seed, fit.ref_tone, *t.vae, cached, source,
-                                    stem + "_reference.png", ref_rgb);
+                                    t.encoder, stem + "_reference.png", ref_rgb);
 }
 
 /// Whether frame i shows the training view: the scene as fitted, without -D overrides.

@@ -55,8 +55,8 @@ Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, con
     if (!job.reference_cache.empty())
         cached = (fs::path(job.reference_cache) / training_reference_key(iw, ih, job.ref_spp, job.ref_tone)).string();
     t.data = cached_encoded_reference(scene, iw, ih, job.ref_spp, kReferenceSeed, job.ref_tone, vae, cached,
-                                      reference_source(scene, job.defines), (out / "reference.png").string(), ref_rgb,
-                                      report);
+                                      reference_source(scene, job.defines), vae_encoder_fingerprint(job.vae),
+                                      (out / "reference.png").string(), ref_rgb, report);
     write_exr((out / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}, true});
     t.width = iw / 8;
     t.height = ih / 8;

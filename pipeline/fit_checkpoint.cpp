@@ -28,7 +28,9 @@ nlohmann::json stage1_settings(const FitJob& job) {
                      {"patience", o.patience},
                      {"min_delta", o.min_delta},
                      {"smoothing", o.smoothing},
-                     {"reuse_paths", o.reuse_paths}});
+                     {"reuse_paths", o.reuse_paths},
+                     // the VAE the target was encoded by, by content (a rerun with another --vae-*)
+                     {"vae_encoder", job.encode ? vae_encoder_fingerprint(job.vae) : ""}});
     return settings;
 }
 
@@ -36,8 +38,10 @@ namespace {
 
 /// Settings added after checkpoints began to record theirs, with the value every checkpoint
 /// made before them had: one without the key resumes when the setting still has that value.
+/// null: the value is not known (the VAE, recorded since session 51), and one without the key
+/// resumes whatever the setting is now, as it did before.
 const nlohmann::json& settings_added_later() {
-    static const nlohmann::json added = {{"emitter_response_decay", 0.0}};
+    static const nlohmann::json added = {{"emitter_response_decay", 0.0}, {"vae_encoder", nullptr}};
     return added;
 }
 
@@ -48,6 +52,7 @@ std::string settings_difference(const nlohmann::json& recorded, const nlohmann::
     for (const auto& [key, value] : wanted.items()) {
         const bool has = recorded.contains(key);
         if (!has && !added.contains(key)) return "it records no '" + key + "'";
+        if (!has && added[key].is_null()) continue;
         const nlohmann::json& made_with = has ? recorded[key] : added[key];
         if (made_with != value)
             return "it was made with " + key + " = " + made_with.dump() + ", this fit has " + value.dump();

@@ -102,15 +102,17 @@ std::string reference_source(const Scene& scene, const std::map<std::string, std
 
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
-                                            const std::string& source, const std::string& save_png,
-                                            std::vector<float>& display_rgb, const Reporter& report) {
+                                            const std::string& source, const std::string& encoder,
+                                            const std::string& save_png, std::vector<float>& display_rgb,
+                                            const Reporter& report) {
     namespace fs = std::filesystem;
     if (cache_stem.empty())
         return encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
     const std::string rgb_file = cache_stem + ".exr", latent_file = cache_stem + "_latent.exr";
     const int f = vae.convention().downsample, channels = vae.convention().channels;
+    const std::string encoded_by = source + " encoded by " + encoder;
     const auto write_latent_file = [&](const std::vector<float>& latent) {
-        write_exr(latent_file, Image{width / f, height / f, channels, latent, {}});
+        write_exr(latent_file, Image{width / f, height / f, channels, latent, {}, false, encoded_by});
     };
     if (!fs::exists(rgb_file)) {
         std::vector<float> latent =
@@ -138,7 +140,19 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
     }
     display_rgb = std::move(cached.data);
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});
-    if (fs::exists(latent_file)) return read_fit_image(latent_file, channels, width / f, height / f).data;
+    if (fs::exists(latent_file)) {
+        Image latent = read_fit_image(latent_file, channels, width / f, height / f);
+        if (latent.source == encoded_by) return latent.data;
+        if (latent.source.empty()) {  // from before latents recorded their encoder: taken as this one's
+            latent.source = encoded_by;
+            try {
+                write_exr(latent_file, latent);
+            } catch (const std::exception&) {}
+            return latent.data;
+        }
+        // another VAE's encoding of the same picture (a run with another --vae-*): encoded again
+        report.say(latent_file + " was encoded by another VAE: encoding it again");
+    }
     std::vector<float> latent = vae.encode(display_rgb, width, height);
     write_latent_file(latent);
     return latent;

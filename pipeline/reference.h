@@ -74,11 +74,14 @@ std::string reference_source(const Scene& scene, const std::map<std::string, std
 /// and encode it once. An empty `cache_stem` caches nothing. `display_rgb` receives the display
 /// image and `save_png` (if not empty) a picture of it. The RGB file records `source`
 /// (reference_source) in its header; a cached one that records another throws, naming the file
-/// (two scenes or sequences of one name sharing a cache folder). A cached EXR without the display
-/// mark or the source (written before EXRs had them) is rewritten with them, its pixels unchanged.
+/// (two scenes or sequences of one name sharing a cache folder). The latent file records `source`
+/// and `encoder` (vae_encoder_fingerprint); one another VAE encoded is encoded again. A cached EXR
+/// without the display mark or the records (written before EXRs had them) is rewritten with them,
+/// its pixels unchanged.
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
-                                            const std::string& source, const std::string& save_png,
-                                            std::vector<float>& display_rgb, const Reporter& report = {});
+                                            const std::string& source, const std::string& encoder,
+                                            const std::string& save_png, std::vector<float>& display_rgb,
+                                            const Reporter& report = {});
 
 }  // namespace lpt::pipeline

@@ -1,4 +1,6 @@
 #include "pipeline/vae_source.h"
+#include "core/fingerprint.h"
+#include "core/image_io.h"
 #include "pipeline/paths.h"
 #include "vae/vae.h"
 #include <filesystem>
@@ -18,6 +20,17 @@ std::unique_ptr<Vae> open_vae(const VaeSource& s) {
 bool vae_present(const VaeSource& s) {
     if (s.torchscript()) return fs::exists(s.encoder) && fs::exists(s.decoder) && fs::exists(s.config);
     return fs::exists(fs::path(default_vae_dir(s.dir)) / "taesd3_decoder.safetensors");
+}
+
+std::string vae_encoder_fingerprint(const VaeSource& s) {
+    Fingerprint fingerprint;
+    if (s.torchscript()) {
+        fingerprint.add(read_file(s.encoder));
+        fingerprint.add(read_file(s.config));
+    } else {
+        fingerprint.add(read_file((fs::path(default_vae_dir(s.dir)) / "taesd3_encoder.safetensors").string()));
+    }
+    return "fnv1a64:" + fingerprint.hex();
 }
 
 }  // namespace lpt::pipeline

@@ -21,5 +21,9 @@ struct VaeSource {
 std::unique_ptr<Vae> open_vae(const VaeSource& source);
 /// Whether open_vae can be expected to find its files (for "no VAE: latents only" fallbacks).
 bool vae_present(const VaeSource& source);
+/// A fingerprint of what makes the VAE's encodings what they are: its encoder's weights (and a
+/// TorchScript VAE's vae.json, whose scale and shift it applies), by content, not by path. Cached
+/// latents and fit checkpoints record it, so that another VAE's are never taken for this one's.
+std::string vae_encoder_fingerprint(const VaeSource& source);
 
 }  // namespace lpt::pipeline

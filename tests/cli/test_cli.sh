@@ -267,6 +267,15 @@ if [ -d "$shared/models/taesd3" ]; then
     sed 's/"reflectance": \[0.63, 0.065, 0.05\]/"reflectance": [0.05, 0.065, 0.63]/' "$scene" > "$out/other/scene.json"
     check sh -c "! cmp -s '$scene' '$out/other/scene.json'"
     expect_error "training_16x16_4spp_clip.exr: a cached reference of another scene" "$bin" fit "$out/other/scene.json" --encode --encode-res 16x16 --ref-spp 4 --iterations 3 --spp 1 --final-spp 2 -q --no-refiner --reference-cache "$out/trefs" --out "$out/encc3"
+    # A cached latent another VAE encoded (its record says so) is encoded again, not taken.
+    l1="$out/refs/move_16x16_2spp_clip_frame_0001_own_seed_latent.exr"
+    check sh -c "oiiotool --info -v '$l1' | grep -q '^ *latentpt:source: \"fnv1a64:.* encoded by fnv1a64:'"
+    cp "$l1" "$out/latent_before.exr"
+    oiiotool "$l1" --attrib "latentpt:source" "another VAE" -o "$l1"
+    "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2v"
+    check cmp "$out/ed2/metrics.csv" "$out/ed2v/metrics.csv"
+    check sh -c "oiiotool --info -v '$l1' | grep -q '^ *latentpt:source: \"fnv1a64:.* encoded by fnv1a64:'"
+    check oiiotool "$l1" "$out/latent_before.exr" --fail 0 --failpercent 0 --diff
     oiiotool "$out/marked.exr" --eraseattrib "latentpt:source" -o "$f1"
     check sh -c "! oiiotool --info -v '$f1' | grep -q '^ *latentpt:source: '"
     "$bin" render "$out/enc" --edit "$out/move.json" --reference --ref-spp 2 --spp 2 -q --reference-cache "$out/refs" --out "$out/ed2s"

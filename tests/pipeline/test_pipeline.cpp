@@ -171,6 +171,15 @@ TEST(Pipeline, ACheckpointFromBeforeASettingExistedResumesAtItsOldValueOnly) {
     flat.options.emitter_response_decay = 1e-4f;
     EXPECT_NE(pipeline::settings_difference(old, pipeline::stage1_settings(flat)).find("emitter_response_decay"),
               std::string::npos);
+    // the VAE's fingerprint (since session 51): unknown before, so a checkpoint without it resumes
+    // whatever the VAE; one that records another VAE does not
+    ASSERT_TRUE(old.contains("vae_encoder"));
+    nlohmann::json other_vae = old;
+    other_vae["vae_encoder"] = "fnv1a64:0000000000000000";
+    EXPECT_NE(pipeline::settings_difference(other_vae, pipeline::stage1_settings(job)).find("vae_encoder"),
+              std::string::npos);
+    old.erase("vae_encoder");
+    EXPECT_EQ(pipeline::settings_difference(old, pipeline::stage1_settings(job)), "");
     old.erase("emission_decay");
     EXPECT_NE(pipeline::settings_difference(old, pipeline::stage1_settings(job)).find("records no 'emission_decay'"),
               std::string::npos);
