@@ -173,6 +173,10 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
     char name[64];
     std::snprintf(name, sizeof name, "frame_%04d", i);
     const std::string stem = (out / name).string();
+    // What an earlier run made of this frame goes first: made with a refiner or a VAE this run
+    // lacks, its _refined.exr or pictures would otherwise stay beside the new frame's files.
+    for (const char* suffix : {"_latent.exr", "_aov.exr", "_refined.exr", "_rendered.png", ".png", "_reference.png"})
+        fs::remove(stem + suffix);
     // only with a VAE: an entry kept without one has no pictures for a job that has it
     const bool shared = !job.frame_cache.empty() && t.vae && shows_training_view(job, session, i);
     std::optional<std::string> scores;

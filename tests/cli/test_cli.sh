@@ -188,6 +188,13 @@ if [ -d "$shared/models/taesd3" ]; then
     check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
     check oiiotool "$out/ed/frame_0000_refined.exr" "$out/enc/latent_refined.exr" --fail 0 --failpercent 0 --diff
     check test -s "$out/ed/frame_0000.png"; check test -s "$out/ed/frame_0000_rendered.png"
+    # The same frame rendered again into that folder by a fit without a refiner: the refined
+    # latent, its AOVs and the unrefined picture of the earlier run do not stay beside it.
+    cp -r "$out/enc" "$out/enc_noref" && rm "$out/enc_noref/refiner.pt"
+    cp -r "$out/ed" "$out/ed_noref"
+    "$bin" render "$out/enc_noref" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed_noref"
+    check test -s "$out/ed_noref/frame_0000.png"
+    for f in frame_0000_refined.exr frame_0000_aov.exr frame_0000_rendered.png; do check test ! -e "$out/ed_noref/$f"; done
     # A refiner reading the transport terms (--inputs terms): an identity edit renders them exactly
     # as the fit wrote them (latent_e/a/c.exr), so it reproduces the refined latent too.
     cp -r "$out/enc" "$out/enc_terms"
