@@ -124,5 +124,25 @@ class TimeLeft(unittest.TestCase):
         self.assertEqual((P.duration(59 * 60), P.duration(61 * 60 + 20)), ("59 min", "1 h 01 min"))
 
 
+class SequenceFiles(unittest.TestCase):
+    @unittest.skipUnless(shutil.which("snakemake"), "snakemake not installed")
+    def test_another_frame_count_rewrites_the_sequence_files(self):
+        """<scene>/edits-<kind>.json and view-*.json follow the config: a run with another --frames
+        in the same folder rewrites them (they had no params, and Snakemake reruns a run: rule only
+        when its code changes, so the chunks rendered the old sequence's frames)."""
+        import subprocess
+        scene = X.settings(quick=True)["scenes"][0]
+        targets = [f"{scene}/edits-camera.json", f"{scene}/view-novel.json"]
+        with tempfile.TemporaryDirectory() as d:
+            for frames in (3, 5, 3):
+                c = X.settings(quick=True, frames=frames)
+                subprocess.run(snakemake_command(c, d) + targets, check=True, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+                with open(os.path.join(d, targets[0])) as f:
+                    self.assertEqual(json.load(f)["frames"], frames)
+            with open(os.path.join(d, targets[1])) as f:  # unchanged by --frames: one frame
+                self.assertEqual(json.load(f)["frames"], 1)
+
+
 if __name__ == "__main__":
     unittest.main()
