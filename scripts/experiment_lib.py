@@ -55,8 +55,10 @@ def read_metrics(path):
 
 
 def mean(rows, key):
+    """The mean of column `key` over every row; NaN when any row lacks it (a frame scored without
+    LPIPS weights): a mean over some of the frames would pass for one over all of them."""
     vals = [float(r[key]) for r in rows if r.get(key, "") not in ("", None)]
-    return sum(vals) / len(vals) if vals else float("nan")
+    return sum(vals) / len(vals) if vals and len(vals) == len(rows) else float("nan")
 
 
 def svg_plot(title, series, ylabel, xlabel="frame", xticks=None, width=480, height=260):
@@ -632,7 +634,9 @@ def scene_summary(c, out, scene, failures):
         train = without_timings(json.load(f))
     s = {"training_view": train, "ref_spp": ref_spp_of(c, scene), "edits": {}, "convergence": {}}
     r_l, f_l = train["rendered"].get("rgb_lpips"), train["refined"].get("rgb_lpips")
-    if r_l is not None and f_l is not None and f_l > r_l * 1.0001:
+    if r_l is None or f_l is None:
+        failures.append(f"{scene}: the training view has no LPIPS score (no LPIPS weights?): the orderings are unchecked")
+    elif f_l > r_l * 1.0001:
         failures.append(f"{scene}: refiner worse than the rendered latent on the training view (LPIPS {f_l:.4f} > {r_l:.4f})")
     for kind in KINDS:
         table = sequence_table({name: read_metrics(os.path.join(d, f"{kind}_{name}", "metrics.csv")) for name in fits_of(c)})
@@ -641,8 +645,11 @@ def scene_summary(c, out, scene, failures):
             continue
         base = table["e"]["rgb_lpips"]
         for key in ("ea", "eac"):
-            if key in table and table[key]["rgb_lpips"] > base * 1.05:
-                failures.append(f"{scene}/{kind}: {key} LPIPS {table[key]['rgb_lpips']:.4f} worse than e alone {base:.4f}")
+            # written so that a NaN (a frame without its LPIPS score) fails rather than passes
+            value = table[key]["rgb_lpips"] if key in table else None
+            if value is not None and not value <= base * 1.05:
+                unscored = " (nan: a frame without its LPIPS score)" if value != value or base != base else ""
+                failures.append(f"{scene}/{kind}: {key} LPIPS {value:.4f} worse than e alone {base:.4f}{unscored}")
     for view in c.get("conv_views", ["training", "novel"]):
         s["convergence"][view] = {}
         for spp in c["spp_list"]:

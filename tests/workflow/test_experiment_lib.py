@@ -259,7 +259,7 @@ class NarrowedFits(unittest.TestCase):
     HEADER = ("frame,t,latent_mse,latent_psnr,latent_dssim,rgb_mse_x100,rgb_ssim,rgb_lpips,refined_latent_mse,"
               "refined_latent_psnr,refined_latent_dssim,refined_rgb_mse_x100,refined_rgb_ssim,refined_rgb_lpips")
 
-    def folder(self, out, scene, lpips_of_fit):
+    def folder(self, out, scene, lpips_of_fit, unscored=()):
         d = os.path.join(out, scene)
         os.makedirs(os.path.join(d, "fit_eac"))
         with open(os.path.join(d, "fit_eac", "metrics.json"), "w") as f:
@@ -271,14 +271,16 @@ class NarrowedFits(unittest.TestCase):
             for fit, lpips in lpips_of_fit.items():
                 os.makedirs(os.path.join(d, f"{kind}_{fit}"))
                 rows = [f"{i},0,0.01,30,0.2,0.5,0.8,{lpips + 0.001 * i},0.005,33,0.1,0.2,0.9,{lpips / 2}" for i in self.FRAMES]
+                if fit in unscored:  # frame 15 scored without LPIPS weights: its cells empty
+                    rows[1] = f"{self.FRAMES[1]},0,0.01,30,0.2,0.5,0.8,,0.005,33,0.1,0.2,0.9,"
                 with open(os.path.join(d, f"{kind}_{fit}", "metrics.csv"), "w") as f:
                     f.write("\n".join([self.HEADER] + rows) + "\n")
 
-    def run_summary(self, fits, lpips_of_fit):
+    def run_summary(self, fits, lpips_of_fit, unscored=()):
         c = X.settings(paper=True, scenes=["veach-bidir"])
         c.update(fits=fits, conv_views=[])
         with tempfile.TemporaryDirectory() as out:
-            self.folder(out, "veach-bidir", lpips_of_fit)
+            self.folder(out, "veach-bidir", lpips_of_fit, unscored)
             _, failures = X.write_summary(c, out)
             with open(os.path.join(out, "summary.md")) as f:
                 md = f.read()
@@ -306,6 +308,17 @@ class NarrowedFits(unittest.TestCase):
         self.assertEqual(len(failures), 3, failures)
         self.assertTrue(all("eac LPIPS" in x and "worse than e alone" in x for x in failures), failures)
         self.assertIn("<tr><th></th><th>reference</th><th>Ĩe</th><th>+Ĩa+Ĩc</th><th>+refiner</th></tr>", report)
+
+    def test_a_frame_without_its_lpips_score_makes_the_mean_nan_and_fails_the_ordering(self):
+        """A mean over three of four frames would pass for the sequence's: it is NaN instead, and
+        the ordering check that NaN would pass (every comparison false) fails it."""
+        _, _, table, failures = self.run_summary(["e", "eac"], {"e": 0.3, "eac": 0.2}, unscored=("eac",))
+        self.assertNotEqual(table["eac"]["rgb_lpips"], table["eac"]["rgb_lpips"])  # NaN
+        self.assertAlmostEqual(table["e"]["rgb_lpips"], 0.3 + 0.001 * sum(self.FRAMES) / 4)
+        self.assertEqual(len(failures), 3, failures)
+        self.assertTrue(all("nan: a frame without its LPIPS score" in x for x in failures), failures)
+        self.assertEqual(X.mean([{"k": "1"}, {"k": ""}], "k") != X.mean([{"k": "1"}, {"k": ""}], "k"), True)
+        self.assertEqual(X.mean([{"k": "1"}, {"k": "3"}], "k"), 2.0)
 
 
 if __name__ == "__main__":
