@@ -171,7 +171,10 @@ def main():
                     help="cores per job (every job uses all of them; locally: the machine's)")
     ap.add_argument("--slurm", action="store_true", help="submit the jobs to Slurm with sbatch (docs/workflow.md)")
     ap.add_argument("--jobs", type=int, default=16, help="with --slurm: jobs queued at once")
-    ap.add_argument("--redo", action="store_true", help="recompute everything (default: keep finished jobs' results in --out)")
+    ap.add_argument("--redo", action="store_true",
+                    help="run every job again (Snakemake --forceall); each still continues from what its folder holds "
+                         "(fit checkpoints, frames with the same key, cached references): for results from "
+                         "scratch, give a new --out")
     ap.add_argument("snakemake_args", nargs="*", help="after --: passed to snakemake (e.g. -- --dry-run)")
     a = ap.parse_args()
     c = X.settings(quick=a.quick, scenes=a.scenes.split(",") if a.scenes else None, out=a.out, bin=a.bin,
@@ -189,6 +192,9 @@ def main():
             return 77  # ctest's SKIP_RETURN_CODE
     if not os.path.exists(c["bin"]):
         sys.exit(f"experiment: {c['bin']} not found (bash scripts/build.sh)")
+    # latentpt finds the VAE and LPIPS weights through LATENTPT_SHARED: --shared must reach the
+    # jobs (Snakemake's children, and through sbatch the cluster's), not only the scene paths
+    os.environ["LATENTPT_SHARED"] = c["shared"]
     os.makedirs(c["out"], exist_ok=True)
     lock = open(os.path.join(c["out"], ".experiment.lock"), "w")
     try:  # the kernel frees it once this process and its Snakemake have ended, however (unlike Snakemake's lock)

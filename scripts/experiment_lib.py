@@ -365,7 +365,8 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "param": p.get("param", "code") if param is None else param,
             "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
             "ref_spp": ref_spp or p.get("ref_spp") or (32 if quick else None),
-            "training_ref_spp": p.get("training_ref_spp"), "fits": p.get("fits", list(FITS)), "spp": spp,
+            # an explicit --ref-spp is every reference's, the training view's too
+            "training_ref_spp": None if ref_spp else p.get("training_ref_spp"), "fits": p.get("fits", list(FITS)), "spp": spp,
             "spp_list": [1, 16] if quick else p.get("spp_list", [1, 4, 16, 64, 256, 1024]), "chunk": chunk,
             # --quick: its RGB side reaches the latent floor by 2-4 spp at 128²; 1024 cost a minute of CI
             "equal_error_max_spp": p.get("equal_error_max_spp", 128 if quick else 1024),

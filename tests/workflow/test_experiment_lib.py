@@ -87,6 +87,11 @@ class Preset(unittest.TestCase):
         self.assertEqual(X.image_res_of(c, "cbox-specular"), 256)
         self.assertEqual((c["frame_step"], c["fit_iterations"]), (2, 10))
         self.assertEqual(X.settings()["fits"], list(X.FITS))
+        # --ref-spp overrides every reference's spp, the training view's too (it kept the preset's 512)
+        c = X.settings(paper=True, ref_spp=128)
+        self.assertEqual((X.ref_spp_of(c, "cbox-specular"), X.training_ref_spp_of(c, "cbox-specular")), (128, 128))
+        self.assertIn("--ref-spp 128", X.fit_command(c, "cbox-specular", "e", 2))
+        self.assertEqual(X.training_ref_spp_of(X.settings(paper=True), "cbox-specular"), 512)
 
     def test_latent_target_only_on_the_refined_fit_and_only_when_compensated(self):
         c = X.settings(paper=True, refiner_latent_target="compensated")
