@@ -31,18 +31,23 @@ def run(cmd):
 
 
 def scontrol_state(jobid):
-    """(state or None, job_unknown)"""
+    """(state or None, job_unknown). A preempted job that Slurm will requeue (Requeue=1) is
+    RUNNING: it starts again and may still write its outputs, which Snakemake would otherwise
+    delete as a failed job's."""
     rc, out, err = run(["scontrol", "-o", "show", "job", jobid])
     if rc != 0:
         return None, "Invalid job id" in err
     m = re.search(r"\bJobState=(\S+)", out)
+    if m and m.group(1) == "PREEMPTED" and re.search(r"\bRequeue=1\b", out):
+        return "RUNNING", False
     return (m.group(1) if m else None), False
 
 
 def sacct_state(jobid):
     try:
         rc, out, _ = run(["sacct", "-X", "-n", "-P", "-o", "State", "-j", jobid])
-    except FileNotFoundError:
+    except (OSError, subprocess.TimeoutExpired) as e:  # not installed, or slurmdbd slow
+        print(f"slurm_status: sacct: {e}", file=sys.stderr)
         return None
     if rc != 0 or not out.strip():
         return None
@@ -66,7 +71,9 @@ def main():
     # `sbatch --parsable` may print "jobid;cluster".
     jobid = sys.argv[1].split(";")[0].strip()
 
-    # Retry transient failures (slurmctld busy or restarting) before judging.
+    # Retry transient failures (slurmctld busy or restarting, accounting not yet written for a
+    # job slurmctld has just purged) before judging.
+    unknown = False
     for attempt in range(5):
         try:
             state, unknown = scontrol_state(jobid)
@@ -78,13 +85,12 @@ def main():
         if state is not None:
             print(classify(state))
             return 0
-        if unknown:
-            # Purged by slurmctld and no accounting: the outcome is lost.
-            print(f"slurm_status: job {jobid} unknown to scontrol and sacct",
-                  file=sys.stderr)
-            print("failed")
-            return 0
         time.sleep(1 + attempt)
+    if unknown:
+        # Purged by slurmctld and no accounting record: the outcome is lost.
+        print(f"slurm_status: job {jobid} unknown to scontrol and sacct", file=sys.stderr)
+        print("failed")
+        return 0
     # Controller unreachable: report running so snakemake asks again later.
     print(f"slurm_status: cannot query job {jobid}; assuming running",
           file=sys.stderr)
