@@ -550,7 +550,15 @@ def reference_noise_command(c, scene):
     return shlex.join([sys.executable, os.path.join(ROOT, "scripts", "reference_noise.py"), "--scene-dir", scene,
                        "--seed-dir", NOISE_DIR, "--seed", str(NOISE_SEED), "--ablation", "--size", str(image_res_of(c, scene)),
                        "--ref-spp", str(ref_spp_of(c, scene)), "--frames", ",".join(map(str, frames[KINDS[0]])),
-                       "--bin", c["bin"]])
+                       "--bin", c["bin"]] + fits_option(c))
+
+
+def fits_option(c):
+    """reference_noise.py's --fits when the run's fits are not the ablation's three (so that a
+    narrowed run scores its own fits' frames, not an older run's beside them; the commands of
+    whole runs stay as they were)."""
+    fits = [f for f in fits_of(c) if f != "baseline"]
+    return [] if fits == ["e", "ea", "eac"] else ["--fits", ",".join(fits)]
 
 
 def edit_sequence(c, scene, kind):

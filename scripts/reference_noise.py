@@ -125,7 +125,10 @@ def columns_of(a, scene_dir, seq, frames):
     if not a.ablation:
         cols = {k: (os.path.join(scene_dir, a.folder.format(seq=seq)), png) for k, (_, png) in TWO_COLUMNS.items()}
     else:
-        cols = {k: (os.path.join(scene_dir, folder.format(seq=seq)), png) for k, (folder, png) in ABLATION_COLUMNS.items()}
+        # only the run's fits: an older run's frames of another fit in the folder are not this run's
+        fits = a.fits.split(",")
+        cols = {k: (os.path.join(scene_dir, folder.format(seq=seq)), png) for k, (folder, png) in ABLATION_COLUMNS.items()
+                if k.split("+")[0] in fits}
     for k, (folder, png) in list(cols.items()):
         missing = [os.path.join(folder, png.format(f=f)) for f in frames if not os.path.exists(os.path.join(folder, png.format(f=f)))]
         if missing and not a.ablation:
@@ -146,6 +149,8 @@ def main():
     p.add_argument("--ablation", action="store_true",
                    help="score Table 1's four columns ({seq}_e, {seq}_ea, {seq}_eac rendered and refined) instead "
                         "of --folder's rendered and refined frames, and write Table 1 against each reference")
+    p.add_argument("--fits", default="e,ea,eac",
+                   help="with --ablation: the fits whose columns are scored (an experiment's `fits`)")
     p.add_argument("--report", default="reference_noise", help="report name (.md and .json in the seed dir)")
     p.add_argument("--sequences", default="camera,object,light")
     p.add_argument("--frames", default="0,20,40")

@@ -256,6 +256,24 @@ class SecondReferences(unittest.TestCase):
         for part in ("--scene-dir cbox-specular --seed-dir noise_seed1 --seed 1 --ablation --size 1024 --ref-spp 512",
                      "--frames " + ",".join(map(str, scored))):
             self.assertIn(part, cmd)
+        self.assertNotIn("--fits", cmd)  # the ablation's three: the command as before
+        self.assertIn("--fits eac", X.reference_noise_command(dict(c, fits=["eac"]), "cbox-specular"))
+
+    def test_a_narrowed_run_scores_only_its_own_fits_frames(self):
+        """reference_noise.py --fits eac leaves out the e and ea columns even where an older run's
+        frames of those fits are in the folder."""
+        import argparse
+        import importlib.util
+        spec = importlib.util.spec_from_file_location("reference_noise", os.path.join(X.ROOT, "scripts", "reference_noise.py"))
+        rn = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(rn)
+        with tempfile.TemporaryDirectory() as d:
+            for folder, png in rn.ABLATION_COLUMNS.values():  # every column's frame 0 is there
+                os.makedirs(os.path.join(d, folder.format(seq="light")), exist_ok=True)
+                open(os.path.join(d, folder.format(seq="light"), png.format(f=0)), "w").close()
+            cols = lambda fits: rn.columns_of(argparse.Namespace(ablation=True, fits=fits), d, "light", [0])  # noqa: E731
+            self.assertEqual(sorted(cols("eac")), ["eac", "eac+refiner"])
+            self.assertEqual(sorted(cols("e,ea,eac")), sorted(rn.ABLATION_COLUMNS))
 
 
 class NarrowedFits(unittest.TestCase):
