@@ -192,21 +192,29 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
     return row.str();
 }
 
-/// What a frame's files depend on besides its index: the fit (manifest, parameters, refiner), the
-/// edit file and the render settings, as an FNV-1a hash. frame_NNNN.done starts with it, so
-/// --resume skips a frame only if the same fit and settings made it (a refitted fit, rerun by a
-/// workflow, renders its frames again). A frame that shows the training view does not depend on
-/// the edit file: its name in the frame cache leaves the file out (`with_edits` false).
-std::string frame_hash(const EditJob& job, const EditSession& session, const Tools& tools, bool with_edits) {
+/// The fit folder's files a frame depends on (manifest, parameters, refiners), and the edit file
+/// unless `with_edits` is false, into a fingerprint.
+Fingerprint fit_and_edits(const EditJob& job, bool with_edits) {
     Fingerprint fingerprint;
-    auto add = [&fingerprint](const std::string& text) { fingerprint.add(text); };
     for (const char* file : {"fit.json", "params.json", "refiner.pt"}) {
         const fs::path p = fs::path(job.fitdir) / file;
-        add(fs::exists(p) ? read_file(p.string()) : std::string("absent"));
+        fingerprint.add(fs::exists(p) ? read_file(p.string()) : std::string("absent"));
     }
     const fs::path emitters = fs::path(job.fitdir) / kEmitterRefinerFile;
-    if (fs::exists(emitters)) add(read_file(emitters.string()));  // only then: other folders keep their keys
-    add(with_edits ? read_file(job.edits) : std::string("the training view, in any sequence"));
+    if (fs::exists(emitters))
+        fingerprint.add(read_file(emitters.string()));  // only then: other folders keep their keys
+    fingerprint.add(with_edits ? read_file(job.edits) : std::string("the training view, in any sequence"));
+    return fingerprint;
+}
+
+/// What a frame's files depend on besides its index: `files` (fit_and_edits, read once the
+/// session had loaded them) and the render settings, as an FNV-1a hash. frame_NNNN.done starts
+/// with it, so --resume skips a frame only if the same fit and settings made it (a refitted fit,
+/// rerun by a workflow, renders its frames again). A frame that shows the training view does not
+/// depend on the edit file: its name in the frame cache leaves the file out.
+std::string frame_hash(const EditJob& job, const EditSession& session, const Tools& tools, Fingerprint files) {
+    Fingerprint& fingerprint = files;
+    auto add = [&fingerprint](const std::string& text) { fingerprint.add(text); };
     for (const auto& [key, value] : job.defines) add(key + "=" + value);
     if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before
     add(std::to_string(job.width) + "x" + std::to_string(job.height) + " spp " + std::to_string(job.spp) + " seed " +
@@ -226,8 +234,8 @@ std::string frame_hash(const EditJob& job, const EditSession& session, const Too
 }
 
 /// The first line of frame_NNNN.done.
-std::string frame_key(const EditJob& job, const EditSession& session, const Tools& tools) {
-    return "key " + frame_hash(job, session, tools, true);
+std::string frame_key(const EditJob& job, const EditSession& session, const Tools& tools, const Fingerprint& files) {
+    return "key " + frame_hash(job, session, tools, files);
 }
 
 /// The metrics row of a finished frame whose .done carries `key`; nullopt when it was made from
@@ -244,7 +252,16 @@ std::optional<std::string> finished_row(const fs::path& done, const std::string&
 int render_edits(const EditJob& job, const Reporter& report) {
     if (!fs::is_directory(job.fitdir))
         throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
+    // The frames' key hashes the fit's files as read around the session's loading of them: a fit
+    // or refine writing there meanwhile would give frames of the old files the new files' key,
+    // which --resume would then keep.
+    const Fingerprint before = fit_and_edits(job, true);
     EditSession session(job.fitdir, job.edits, job.defines, job.sampler);
+    const Fingerprint files = fit_and_edits(job, true), files_without_edits = fit_and_edits(job, false);
+    if (files.hex() != before.hex())
+        throw std::runtime_error(job.fitdir +
+                                 ": its files changed while this render loaded them (a fit or refine "
+                                 "writing there?): run again once it has finished");
     const int w = job.width > 0 ? job.width : session.latent_width();
     const int h = job.height > 0 ? job.height : session.latent_height();
     const Tools tools = open_tools(job, session, report);
@@ -267,7 +284,8 @@ int render_edits(const EditJob& job, const Reporter& report) {
                                     " are not within the sequence's 0:" + std::to_string(frames - 1));
     if (job.frame_step < 1) throw std::invalid_argument("frame step must be at least 1");
     const int count = (last - first) / job.frame_step + 1;
-    const std::string key = frame_key(job, session, tools), training_view_key = frame_hash(job, session, tools, false);
+    const std::string key = frame_key(job, session, tools, files),
+                      training_view_key = frame_hash(job, session, tools, files_without_edits);
     bool told = false;
     for (int i = first; i <= last; i += job.frame_step) {
         char name[64];
