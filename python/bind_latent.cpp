@@ -7,6 +7,7 @@
 #include "pipeline/fit_folder.h"
 #include <pybind11/stl.h>
 #include <mutex>
+#include <optional>
 
 namespace lpt::python {
 
@@ -53,7 +54,11 @@ std::shared_ptr<LatentScene> fresh(std::shared_ptr<Scene> scene, const std::stri
 
 std::shared_ptr<LatentScene> from_fit(const std::string& dir, const std::map<std::string, std::string>& defines,
                                       const std::string& sampler) {
-    pipeline::FitFolder f = pipeline::load_fit_folder(dir, defines, sampler_choice(sampler));
+    const std::optional<SamplerKind> chosen = sampler_choice(sampler);
+    pipeline::FitFolder f = [&] {
+        py::gil_scoped_release unlocked;  // parsing, meshes, the BVH: other Python threads go on
+        return pipeline::load_fit_folder(dir, defines, chosen);
+    }();
     auto ls = std::make_shared<LatentScene>();
     ls->scene = std::shared_ptr<Scene>(std::move(f.scene));
     ls->model = std::move(f.model);

@@ -263,12 +263,14 @@ void bind_pipeline(py::module_& m) {
           "replaces the fit's.");
     py::class_<PyVae>(m, "Vae", "An image autoencoder: TAESD3 weights in a folder (default ../shared/models/taesd3).")
         .def(py::init([](const std::string& dir) {
+                 py::gil_scoped_release unlocked;  // loading weights: other Python threads go on
                  return PyVae{std::shared_ptr<Vae>(pipeline::open_vae({dir, "", "", ""}))};
              }),
              py::arg("dir") = "")
         .def_static(
             "from_fit",
             [](const std::string& fitdir) {
+                py::gil_scoped_release unlocked;
                 return PyVae{std::shared_ptr<Vae>(pipeline::open_vae(pipeline::manifest_vae(fitdir + "/fit.json")))};
             },
             py::arg("fitdir"), "The VAE a fit folder was fitted with (its fit.json).")

@@ -53,7 +53,9 @@ void bind_scene(py::module_& m) {
                                               "A scene file (.json or Mitsuba 3 .xml) loaded for rendering.")
         .def(py::init([](const std::string& path, const std::map<std::string, std::string>& defines,
                          const std::string& sampler) {
-                 return std::make_shared<Scene>(load_scene(path, defines, sampler_choice(sampler)));
+                 const std::optional<SamplerKind> chosen = sampler_choice(sampler);
+                 py::gil_scoped_release unlocked;  // parsing, meshes, the BVH: other Python threads go on
+                 return std::make_shared<Scene>(load_scene(path, defines, chosen));
              }),
              py::arg("path"), py::arg("defines") = std::map<std::string, std::string>{}, py::arg("sampler") = "",
              "Loads a scene; `defines` override values as -D does on the command line, `sampler` ('sobol' or "
