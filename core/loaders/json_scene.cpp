@@ -91,10 +91,15 @@ struct Ctx {
     }
     /// One op object, or a list of ops applied in order (each later op left-multiplies).
     Transform transform(const json& j, const std::string& field) const {
-        if (j.is_object()) return transform_op(j, field);
-        if (!j.is_array()) fail(field, "expected a transform object or a list of them");
+        if (!j.is_object() && !j.is_array()) fail(field, "expected a transform object or a list of them");
         Transform t;
-        for (size_t i = 0; i < j.size(); ++i) t = transform_op(j[i], field + "[" + std::to_string(i) + "]") * t;
+        if (j.is_object()) t = transform_op(j, field);
+        else
+            for (size_t i = 0; i < j.size(); ++i) t = transform_op(j[i], field + "[" + std::to_string(i) + "]") * t;
+        // as the XML loader: a camera whose frame collapses sends Embree rays of zero direction
+        // (an assertion abort), a shape whose frame collapses has no surface
+        const float det = t.m.topLeftCorner<3, 3>().determinant();
+        if (!(std::abs(det) > 0.f) || !t.inv.allFinite()) fail(field, "transform is singular");
         return t;
     }
 
@@ -210,6 +215,9 @@ void read_integrator(const Ctx& c, const json& root, IntegratorSettings& s) {
     if (!ij) return;
     if (auto* v = c.opt(*ij, "max_depth")) s.max_depth = c.integer(*v, "integrator.max_depth");
     if (auto* v = c.opt(*ij, "rr_depth")) s.rr_depth = c.integer(*v, "integrator.rr_depth");
+    // the XML loader's ranges
+    if (s.max_depth < -1) c.fail("integrator.max_depth", "must be >= -1 (-1: unbounded)");
+    if (s.rr_depth < 1) c.fail("integrator.rr_depth", "must be >= 1");
     if (auto* v = c.opt(*ij, "spp")) s.spp = c.integer(*v, "integrator.spp");
     if (s.spp < 1) c.fail("integrator.spp", "must be >= 1");
     if (auto* v = c.opt(*ij, "sampler")) {
@@ -247,6 +255,9 @@ void read_camera(const Ctx& c, const json& root, Camera& cam) {
     if (cam.width < 1 || cam.height < 1) c.fail("camera.width", "resolution must be positive");
     if (auto* v = c.opt(*cj, "near_clip")) cam.near_clip = c.number(*v, "camera.near_clip");
     if (auto* v = c.opt(*cj, "far_clip")) cam.far_clip = c.number(*v, "camera.far_clip");
+    // the XML loader's ranges: outside them every ray is clipped and the image is black
+    if (!(cam.near_clip > 0.f)) c.fail("camera.near_clip", "must be > 0");
+    if (!(cam.far_clip > cam.near_clip)) c.fail("camera.far_clip", "must be > near_clip");
     if (auto* f = c.opt(*cj, "filter")) {
         std::string ft = f->is_object() && f->contains("type") ? c.string((*f)["type"], "camera.filter.type") : "";
         if (ft == "box") cam.filter = {PixelFilter::Type::Box, 0.5f};

@@ -80,6 +80,29 @@ TEST(JsonScene, MalformedJsonReportsPosition) {
     EXPECT_NE(err.find("line 2"), std::string::npos) << err;
 }
 
+// Values the XML loader refuses are refused here too, naming the field: a collapsed camera frame
+// (Embree aborted on its zero-direction rays), clip planes that clip every ray, depths out of range.
+TEST(JsonScene, DegenerateCameraAndOutOfRangeSettingsNameTheirField) {
+    auto with_camera = [](const std::string& camera, const std::string& integrator = "{}") {
+        return std::string(R"({"camera": )") + camera + R"(, "integrator": )" + integrator + R"(, "materials": {)" +
+               kWhite + "}, \"shapes\": [" + kQuad + "]}";
+    };
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {with_camera(R"({"to_world": {"scale": 0}})"), "camera.to_world"},
+        {with_camera(R"({"to_world": [{"scale": 1e-30}, {"translate": [0, 0, 5]}]})"), "camera.to_world"},
+        {with_camera(R"({"near_clip": -1})"), "camera.near_clip"},
+        {with_camera(R"({"near_clip": 5, "far_clip": 1})"), "camera.far_clip"},
+        {with_camera("{}", R"({"max_depth": -5})"), "integrator.max_depth"},
+        {with_camera("{}", R"({"rr_depth": 0})"), "integrator.rr_depth"},
+    };
+    for (const auto& [json, field] : cases) {
+        const std::string err = load_error("degenerate.json", json);
+        EXPECT_NE(err.find(field), std::string::npos) << field << ": " << err;
+    }
+    std::string shape = R"({"id": "q", "type": "rectangle", "material": "white", "to_world": {"scale": [1, 0, 1]}})";
+    EXPECT_NE(load_error("flat.json", scene_json(kWhite, shape)).find("shapes[0].to_world"), std::string::npos);
+}
+
 TEST(JsonScene, UnknownMaterialTypeNamesField) {
     std::string err = load_error("badmat.json", scene_json(R"("white": {"type": "velvet"})", kQuad));
     EXPECT_NE(err.find("badmat.json"), std::string::npos) << err;
