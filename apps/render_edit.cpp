@@ -12,14 +12,12 @@ namespace {
 
 /// "A:B" or "A:B:S" with 0 <= A <= B and S >= 1 (every S-th frame from A).
 void parse_frames(const std::string& s, int& first, int& last, int& step) {
-    char c1 = 0, c2 = 0;
-    int a = -1, b = -1, k = 1;
-    const int n = std::sscanf(s.c_str(), "%d%c%d%c%d", &a, &c1, &b, &c2, &k);
-    if ((n != 3 && n != 5) || c1 != ':' || (n == 5 && c2 != ':') || a < 0 || b < a || k < 1)
+    const std::optional<std::vector<int>> v = pipeline::split_integers(s, ':');
+    if (!v || (v->size() != 2 && v->size() != 3) || (*v)[1] < (*v)[0] || (v->size() == 3 && (*v)[2] < 1))
         throw std::invalid_argument("--frames expects A:B or A:B:S with 0 <= A <= B and S >= 1, got '" + s + "'");
-    first = a;
-    last = b;
-    step = k;
+    first = (*v)[0];
+    last = (*v)[1];
+    step = v->size() == 3 ? (*v)[2] : 1;
 }
 
 }  // namespace

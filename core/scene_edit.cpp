@@ -153,9 +153,11 @@ EditSequence load_edits(const std::string& path, const Scene& scene) {
         if (key != "frames" && key != "camera" && key != "shapes")
             p.fail(key, "unknown key (known: frames, camera, shapes)");
     if (j.contains("frames")) {
-        if (!j["frames"].is_number_integer() || j["frames"].get<int>() < 1)
-            p.fail("frames", "expected an integer >= 1");
-        seq.frames = j["frames"].get<int>();
+        // read as int64 first: get<int>() of 4294967297 wrapped to 1
+        const json& f = j["frames"];
+        if (!f.is_number_integer() || f.get<int64_t>() < 1 || f.get<int64_t>() > 1000000)
+            p.fail("frames", "expected an integer in [1, 1000000]");
+        seq.frames = int(f.get<int64_t>());
     }
     if (j.contains("camera")) seq.camera = read_camera_edit(p, j["camera"], scene);
     if (j.contains("shapes")) seq.shapes = read_shape_edits(p, j["shapes"], scene);

@@ -89,6 +89,7 @@ TEST(SceneEdit, ErrorsNameFileAndField) {
               std::string::npos);
     EXPECT_NE(edit_error(s, R"({"shapes": [{"id": "light", "spin": 3}]})").find("shapes[0].spin"), std::string::npos);
     EXPECT_NE(edit_error(s, R"({"frames": 0})").find("frames"), std::string::npos);
+    EXPECT_NE(edit_error(s, R"({"frames": 4294967297})").find("frames"), std::string::npos);  // wrapped to 1
     EXPECT_NE(edit_error(s, R"({"camera": {"zoom": 2}})").find("camera"), std::string::npos);
     EXPECT_NE(edit_error(s, R"({"frames": )").find("malformed"), std::string::npos);
 }
