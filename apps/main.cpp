@@ -206,7 +206,8 @@ struct Cli {
         fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")
             ->capture_default_str();
         fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(positive());
         fit->add_option("--reference-cache", f.job.reference_cache,
                         "with --encode: keep the encoded reference here and reuse it (fits of one scene share it)");
         fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")

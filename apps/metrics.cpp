@@ -48,6 +48,7 @@ struct Loaded {
 
 Loaded load(const std::string& path) {
     Image img = read_image(path);
+    require_finite_pixels(img, path);  // else "MSE nan ... PSNR inf (identical)"
     Loaded l;
     l.width = img.width;
     l.height = img.height;

@@ -23,6 +23,7 @@ void require_rgb(const Image& img, const std::string& path) {
 
 int run_encode(const VaeArgs& a) {
     Image img = read_image(a.input);
+    require_finite_pixels(img, a.input);  // the encoder spreads one NaN over its whole receptive field
     auto vae = pipeline::open_vae(a.vae);
     // TAESD wants display values; a linear EXR is mapped as fit maps its references, so that a
     // render's encoding here is the latent fit --encode would target.
@@ -38,6 +39,7 @@ int run_encode(const VaeArgs& a) {
 
 int run_decode(const VaeArgs& a) {
     Image lat = read_image(a.input);
+    require_finite_pixels(lat, a.input);
     auto vae = pipeline::open_vae(a.vae);
     if (lat.channels != vae->convention().channels)
         throw std::runtime_error(a.input + ": " + std::to_string(lat.channels) + " channels, the VAE's latents have " +

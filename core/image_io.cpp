@@ -179,6 +179,16 @@ std::string read_file(const std::string& path) {
     return ss.str();
 }
 
+void require_finite_pixels(const Image& img, const std::string& path) {
+    for (size_t i = 0; i < img.data.size(); ++i)
+        if (!std::isfinite(img.data[i])) {
+            const size_t c = size_t(std::max(img.channels, 1)), pixel = i / c;
+            throw std::runtime_error(path + ": value at pixel (" + std::to_string(pixel % size_t(img.width)) + ", " +
+                                     std::to_string(pixel / size_t(img.width)) + "), channel " + std::to_string(i % c) +
+                                     " is not finite");
+        }
+}
+
 void write_text_atomic(const std::string& path, const std::string& contents) {
     write_atomically(
         path,

@@ -33,6 +33,9 @@ void write_png_srgb(const std::string& path, const Image& img, float exposure = 
 void write_png_display(const std::string& path, const Image& img);
 /// Any format OIIO reads; throws std::runtime_error naming the file on failure.
 Image read_image(const std::string& path);
+/// Throws std::runtime_error naming `path`, the pixel and the channel of the first value of `img`
+/// that is NaN or infinite: for commands whose answer would otherwise be NaN, or worse, "identical".
+void require_finite_pixels(const Image& img, const std::string& path);
 /// The whole file as bytes; throws SceneError(path, "", "cannot open file") if it cannot be read.
 std::string read_file(const std::string& path);
 /// Writes `contents` to path atomically (temp + rename); a write that does not complete (a full

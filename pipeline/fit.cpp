@@ -197,6 +197,7 @@ void validate(const FitJob& job) {
     require(o.min_delta >= 0.f && std::isfinite(o.min_delta), "--min-delta", ">= 0", o.min_delta);
     require(o.checkpoint_every >= 0, "--checkpoint-every", ">= 0", o.checkpoint_every);
     require(o.reuse_paths >= 0, "--reuse-paths", ">= 0", o.reuse_paths);
+    require(job.ref_spp > 0, "--ref-spp", "> 0", job.ref_spp);  // 0 traced an all-black reference
     for (const auto& [flag, value] : {std::pair{"--emission-decay", job.options.emission_decay},
                                       std::pair{"--emitter-response-decay", job.options.emitter_response_decay}})
         if (!(value >= 0.f) || !std::isfinite(value))

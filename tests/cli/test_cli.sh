@@ -119,6 +119,17 @@ if [ -d "$shared/models/taesd3" ]; then
     printf '%s\t%s\n' "$out/m1.png" "$out/nope.png" > "$out/bad_pairs.txt"
     expect_error "nope.png not found" "$bin" metrics --pairs "$out/bad_pairs.txt"
     expect_error "excludes" "$bin" metrics "$out/m1.png" "$out/m2.png" --pairs "$out/pairs.txt"
+    # A NaN in an image is an error naming it: metrics said "MSE nan ... PSNR inf (identical)",
+    # encode wrote NaN latents, decode a black picture.
+    oiiotool --pattern constant:color=nan,0.5,0.5 16x16 3 -d float -o "$out/nan.exr"
+    oiiotool --pattern constant:color=0.5,0.5,0.5 16x16 3 -d float -o "$out/half.exr"
+    expect_error "nan.exr: value at pixel (0, 0), channel 0 is not finite" "$bin" metrics "$out/nan.exr" "$out/half.exr"
+    expect_error "nan.exr: value at pixel (0, 0), channel 0 is not finite" "$bin" encode "$out/nan.exr" -q --out "$out/nan_latent.exr"
+    oiiotool --pattern constant:color=0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,nan 2x2 16 -d float -o "$out/nan16.exr"
+    expect_error "nan16.exr: value at pixel (0, 0), channel" "$bin" decode "$out/nan16.exr" -q --out "$out/nan.png"
+    # Resolutions and frame ranges are whole integers in range: sscanf read '4294967304x8' as 8x8.
+    expect_error "--res expects WxH" "$bin" render "$scene" --res 4294967304x8 --spp 1 -q --out "$out/wrap.exr"
+    expect_error "--res expects WxH" "$bin" render "$scene" --res 8x8junk --spp 1 -q --out "$out/wrap.exr"
     # The TorchScript VAE path from the command line: TAESD3 exported by our script encodes alike.
     py=/usr/bin/python3; [ -x "$py" ] || py=python3
     if "$py" -c 'import torch' 2>/dev/null && "$py" "$src/tools/export_taesd3.py" --weights "$shared/models/taesd3" --out "$out/ts" >/dev/null; then
@@ -185,6 +196,7 @@ if [ -d "$shared/models/taesd3" ]; then
     # An identity edit reproduces the fit's final latent and refined latent exactly (same seed and spp).
     printf '{"frames": 1}' > "$out/identity.json"
     "$bin" render "$out/enc" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed"
+    expect_error "--frames expects A:B" "$bin" render "$out/enc" --edit "$out/identity.json" --frames 0:4294967297 -q --out "$out/ed_wrap"
     check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
     check oiiotool "$out/ed/frame_0000_refined.exr" "$out/enc/latent_refined.exr" --fail 0 --failpercent 0 --diff
     check test -s "$out/ed/frame_0000.png"; check test -s "$out/ed/frame_0000_rendered.png"

@@ -148,6 +148,7 @@ TEST(Pipeline, FitOptionsOutOfRangeAreRefusedByName) {
         {"--lr-period", [](pipeline::FitJob& j) { j.options.lr_period = 0; }},
         {"--min-delta", [](pipeline::FitJob& j) { j.options.min_delta = -1.f; }},
         {"--reuse-paths", [](pipeline::FitJob& j) { j.options.reuse_paths = -1; }},
+        {"--ref-spp", [](pipeline::FitJob& j) { j.ref_spp = -5; }},
     };
     for (const auto& [flag, spoil] : cases) {
         pipeline::FitJob job = good;
