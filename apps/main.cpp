@@ -73,7 +73,9 @@ struct Cli {
         render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr");
         render->add_option("--aov-res", r.aov_res, "AOV resolution WxH (default: the image's; latents: image/8)");
         render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")->capture_default_str();
-        render->add_option("-D,--define", defines, "override a scene value, e.g. -D integrator.max_depth=4");
+        render->add_option("-D,--define", defines,
+                           "override a scene value: a key path of a .json scene (-D integrator.max_depth=4), a "
+                           "$parameter of a Mitsuba .xml scene (-D spp=16; a name the file does not use does nothing)");
         render->add_flag("-q,--quiet", r.quiet, "no progress line");
     }
 
