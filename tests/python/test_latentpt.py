@@ -117,20 +117,14 @@ class LatentTest(unittest.TestCase):
         for g in got:
             self.assertTrue(any(np.array_equal(g, e) for e in expected), "a render of half-written parameters")
 
-    def check_adjoint(self, m, entries):
-        """Raw gradient of a fixed linear functional of the linear latent against central
-        differences, at the raw entries `entries` ({slice name: offsets within its raw})."""
-        rng = np.random.default_rng(1)
-        w = rng.uniform(-1, 1, (m.height, m.width, 16)).astype(np.float32)
-        # Before the tone curve: its x^(1/2.2) is singular at 0, where fresh L̃a values start.
-        loss = lambda: float((w * m.render_linear(spp=4, seed=7)).sum(dtype=np.float64))  # noqa: E731
-        grad = m.backward_linear(w, spp=4, seed=7)
+    def check_against_central_differences(self, m, loss, grad, entries, what="adjoint"):
+        """`grad` (of `loss`, a function of m's raw parameters) against central differences at the
+        raw entries `entries` ({slice name: offsets within its raw})."""
         raw0 = m.raw.copy()
         checked = 0
         for s in m.slices():
             for k in entries.get(s["name"], ()):
-                i = s["raw_offset"] + k
-                h = 1e-2
+                i, h = s["raw_offset"] + k, 1e-2
                 up, down = raw0.copy(), raw0.copy()
                 up[i] += h
                 down[i] -= h
@@ -139,10 +133,19 @@ class LatentTest(unittest.TestCase):
                 m.raw = down
                 lm = loss()
                 fd = (lp - lm) / (2 * h)
-                self.assertLess(abs(grad[i] - fd), 2e-2 * max(1.0, abs(fd)), f"{s['name']}[{k}]: adjoint {grad[i]} fd {fd}")
+                self.assertLess(abs(grad[i] - fd), 2e-2 * max(1.0, abs(fd)), f"{s['name']}[{k}]: {what} {grad[i]} fd {fd}")
                 checked += 1
         m.raw = raw0
         self.assertEqual(checked, sum(len(v) for v in entries.values()))
+
+    def check_adjoint(self, m, entries):
+        """Raw gradient of a fixed linear functional of the linear latent against central
+        differences, at the raw entries `entries` ({slice name: offsets within its raw})."""
+        rng = np.random.default_rng(1)
+        w = rng.uniform(-1, 1, (m.height, m.width, 16)).astype(np.float32)
+        # Before the tone curve: its x^(1/2.2) is singular at 0, where fresh L̃a values start.
+        loss = lambda: float((w * m.render_linear(spp=4, seed=7)).sum(dtype=np.float64))  # noqa: E731
+        self.check_against_central_differences(m, loss, m.backward_linear(w, spp=4, seed=7), entries)
 
     def test_adjoint_matches_central_differences(self):
         names = ("light.Le", "floor.La", "back.Lc", "red_wall.bsdf.reflectance", "background")
@@ -177,25 +180,9 @@ class LatentTest(unittest.TestCase):
         self.assertGreater(usable.mean(), 0.3)
         w = (np.random.default_rng(3).uniform(-1, 1, linear.shape) * usable).astype(np.float32)
         (torch.from_numpy(w) * lt.render_latent(m, raw, spp=4, seed=7)).sum().backward()
-        grad = raw.grad.numpy()
-        raw0 = raw.detach().numpy().copy()
         loss = lambda: float((w * m.render(spp=4, seed=7)).sum(dtype=np.float64))  # noqa: E731
-        checked = 0
-        for s in m.slices():
-            for k in {"light.Le": (0, 5), "floor.La": (0,), "back.Lc": (3,), "red_wall.bsdf.reflectance": (0,)}.get(s["name"], ()):
-                i, h = s["raw_offset"] + k, 1e-2
-                up, down = raw0.copy(), raw0.copy()
-                up[i] += h
-                down[i] -= h
-                m.raw = up
-                lp = loss()
-                m.raw = down
-                lm = loss()
-                fd = (lp - lm) / (2 * h)
-                self.assertLess(abs(grad[i] - fd), 2e-2 * max(1.0, abs(fd)), f"{s['name']}[{k}]: autograd {grad[i]} fd {fd}")
-                checked += 1
-        m.raw = raw0
-        self.assertEqual(checked, 5)
+        entries = {"light.Le": (0, 5), "floor.La": (0,), "back.Lc": (3,), "red_wall.bsdf.reflectance": (0,)}
+        self.check_against_central_differences(m, loss, raw.grad.numpy(), entries, "autograd")
 
     def test_torch_function_backward_is_the_adjoint(self):
         torch = torch_or_skip()
