@@ -1,5 +1,6 @@
 // `latentpt render`: scene → float EXR + sRGB PNG preview (+ AOV EXRs).
 #include "apps/commands.h"
+#include "core/film.h"
 #include "core/image_io.h"
 #include "core/scene_loader.h"
 #include "integrators/aov.h"
@@ -25,6 +26,16 @@ int run_render(const RenderArgs& a) {
     if (a.spp > 0) opt.spp = a.spp;
     if (a.max_depth != -2) opt.max_depth = a.max_depth;
     if (!a.res.empty()) parse_resolution(a.res, opt.width, opt.height, "--res");
+    // the AOVs' size is checked before the render, not found too large after it
+    int aw = opt.width, ah = opt.height;
+    if (a.aov && !a.aov_res.empty()) {
+        parse_resolution(a.aov_res, aw, ah, "--aov-res");
+        try {
+            check_image_fits(aw, ah, 7);  // normal, distance, albedo
+        } catch (const std::length_error& e) {
+            throw std::invalid_argument(std::string("--aov-res: ") + e.what());
+        }
+    }
     opt.strategy = a.strategy == "nee"    ? LightStrategy::Nee
                    : a.strategy == "bsdf" ? LightStrategy::Bsdf
                                           : LightStrategy::Mis;
@@ -42,8 +53,6 @@ int run_render(const RenderArgs& a) {
     write_exr(a.out, img);
     write_png_srgb(with_suffix(a.out, ".png"), img, a.exposure);
     if (a.aov) {
-        int aw = img.width, ah = img.height;
-        if (!a.aov_res.empty()) parse_resolution(a.aov_res, aw, ah, "--aov-res");
         AovImages aov = render_aovs(scene, spectra, aw, ah, std::min(opt.spp, 16), a.seed, opt.sampler);
         write_exr(with_suffix(a.out, ".normal.exr"), Image{aov.width, aov.height, 3, aov.normal, {"X", "Y", "Z"}});
         write_exr(with_suffix(a.out, ".distance.exr"), Image{aov.width, aov.height, 1, aov.distance, {"Z"}});

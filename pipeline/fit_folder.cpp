@@ -1,5 +1,6 @@
 #include "pipeline/fit_folder.h"
 #include "autodiff/fit.h"
+#include "core/film.h"
 #include "core/json_number.h"
 #include "core/scene_loader.h"
 #include "integrators/path.h"
@@ -87,6 +88,14 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
         f.tone = parse_tone_curve(m.value("tone", "clip"));
         f.latent_width = json_int(m.at("latent_width"), manifest_path, "latent_width", 1, 1 << 20);
         f.latent_height = json_int(m.at("latent_height"), manifest_path, "latent_height", 1, 1 << 20);
+        // before anything is traced at that size (the unseen-emitter grid alone ran for minutes
+        // without a word at 100000²): a latent film, its AOVs and the decoded picture
+        try {
+            check_image_fits(f.latent_width, f.latent_height, 2 * kLatentChannels + 1);
+            check_image_fits(8 * f.latent_width, 8 * f.latent_height, 3);
+        } catch (const std::length_error& e) {
+            throw std::runtime_error(manifest_path + ": latent_width x latent_height: " + e.what());
+        }
         f.ref_tone = m.value("ref_tone", "clip");
         f.vae = vae_source_of(m);
     } catch (const nlohmann::json::exception& e) {

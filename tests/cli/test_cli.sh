@@ -130,6 +130,8 @@ if [ -d "$shared/models/taesd3" ]; then
     # Resolutions and frame ranges are whole integers in range: sscanf read '4294967304x8' as 8x8.
     expect_error "--res expects WxH" "$bin" render "$scene" --res 4294967304x8 --spp 1 -q --out "$out/wrap.exr"
     expect_error "--res expects WxH" "$bin" render "$scene" --res 8x8junk --spp 1 -q --out "$out/wrap.exr"
+    # Sizes beyond the machine's memory are refused before any work, naming where they come from.
+    expect_error "--aov-res: an image of 100000x100000 pixels needs" "$bin" render "$scene" --aov --aov-res 100000x100000 --res 8x8 --spp 1 -q --out "$out/huge.exr"
     # The TorchScript VAE path from the command line: TAESD3 exported by our script encodes alike.
     py=/usr/bin/python3; [ -x "$py" ] || py=python3
     if "$py" -c 'import torch' 2>/dev/null && "$py" "$src/tools/export_taesd3.py" --weights "$shared/models/taesd3" --out "$out/ts" >/dev/null; then
@@ -197,6 +199,9 @@ if [ -d "$shared/models/taesd3" ]; then
     printf '{"frames": 1}' > "$out/identity.json"
     "$bin" render "$out/enc" --edit "$out/identity.json" --seed 1 --spp 2 -q --out "$out/ed"
     expect_error "--frames expects A:B" "$bin" render "$out/enc" --edit "$out/identity.json" --frames 0:4294967297 -q --out "$out/ed_wrap"
+    mkdir -p "$out/enc_huge" && cp "$out/enc/fit.json" "$out/enc/params.json" "$out/enc_huge/"
+    sed -i 's/"latent_width": [0-9]*/"latent_width": 100000/; s/"latent_height": [0-9]*/"latent_height": 100000/' "$out/enc_huge/fit.json"
+    expect_error "fit.json: latent_width x latent_height: an image of" timeout 60 "$bin" render "$out/enc_huge" --edit "$out/identity.json" -q --out "$out/ed_huge"
     check oiiotool "$out/ed/frame_0000_latent.exr" "$out/enc/latent.exr" --fail 0 --failpercent 0 --diff
     check oiiotool "$out/ed/frame_0000_refined.exr" "$out/enc/latent_refined.exr" --fail 0 --failpercent 0 --diff
     check test -s "$out/ed/frame_0000.png"; check test -s "$out/ed/frame_0000_rendered.png"
