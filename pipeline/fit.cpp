@@ -35,11 +35,7 @@ Target load_target_exr(const std::string& path) {
         throw std::runtime_error(path + ": target has " + std::to_string(img.channels) +
                                  " channels, a latent map needs " + std::to_string(kLatentChannels) +
                                  " (an RGB image needs --encode)");
-    size_t bad = 0;
-    if (!check_finite(img.data.data(), img.data.size(), &bad))
-        throw std::runtime_error(path + ": value at pixel (" + std::to_string(bad / kLatentChannels % img.width) +
-                                 ", " + std::to_string(bad / kLatentChannels / img.width) + "), channel " +
-                                 std::to_string(bad % kLatentChannels) + " is not finite");
+    require_finite_pixels(img, path);
     return {img.data, img.width, img.height};
 }
 

@@ -1,9 +1,9 @@
 // `import latentpt`: the native part (_latentpt). python/latentpt/__init__.py re-exports it and
 // latentpt/torch.py adds the autograd function. docs/python.md.
 #include "bindings.h"
+#include "autodiff/loss.h"
 #include "core/error.h"
 #include "pipeline/progress.h"
-#include <cmath>
 #include <string>
 
 namespace lpt::python {
@@ -28,8 +28,9 @@ std::vector<float> from_numpy(const py::array_t<float, py::array::c_style | py::
     if (got != shape)
         throw py::value_error(what + ": expected an array of shape " + shape_text(shape) + ", got " + shape_text(got));
     std::vector<float> v(a.data(), a.data() + a.size());
-    for (size_t i = 0; i < v.size(); ++i)
-        if (!std::isfinite(v[i])) throw py::value_error(what + ": value " + std::to_string(i) + " is not finite");
+    size_t bad = 0;
+    if (!check_finite(v.data(), v.size(), &bad))
+        throw py::value_error(what + ": value " + std::to_string(bad) + " is not finite");
     return v;
 }
 
