@@ -113,11 +113,8 @@ std::vector<float> frame_reference(const EditJob& job, const FitFolder& fit, con
                                                           job.ref_spp, fit.ref_tone, frame)) +
                    reference_seed_suffix(job.ref_seed)))
                      .string();
-    // the scene's defines: the fit's, with the render's -D on top (load_fit_folder's order)
-    std::map<std::string, std::string> defines = fit.manifest.value("defines", std::map<std::string, std::string>{});
-    for (const auto& [key, value] : job.defines) defines[key] = value;
-    const std::string source =
-        unedited ? reference_source(*fit.scene, defines) : reference_source(*fit.scene, defines, job.edits, index);
+    const std::string source = unedited ? reference_source(*fit.scene, fit.defines)
+                                        : reference_source(*fit.scene, fit.defines, job.edits, index);
     return cached_encoded_reference(*fit.scene, 8 * w, 8 * h, job.ref_spp, seed, fit.ref_tone, *t.vae, cached, source,
                                     t.encoder, stem + "_reference.png", ref_rgb);
 }

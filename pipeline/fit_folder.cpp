@@ -69,7 +69,8 @@ FitFolder load_fit_folder(const std::string& dir_name, const std::map<std::strin
     const nlohmann::json& m = f.manifest;
     if (!m.is_object()) throw std::runtime_error(manifest_path + ": expected a JSON object");
     try {
-        std::map<std::string, std::string> defines = m.value("defines", std::map<std::string, std::string>{});
+        std::map<std::string, std::string>& defines = f.defines;
+        defines = m.value("defines", std::map<std::string, std::string>{});
         for (const auto& [k, v] : overrides) defines[k] = v;
         const std::string scene = m.at("scene").get<std::string>();
         std::error_code ec;  // a name too long for the file system is an error, not an exception

@@ -27,6 +27,8 @@ struct FitFolder {
     std::string dir;
     nlohmann::json manifest;       ///< fit.json
     std::unique_ptr<Scene> scene;  ///< owned here: the model refers to it
+    /// The -D values `scene` was loaded with: fit.json's, with the loader's overrides on top.
+    std::map<std::string, std::string> defines;
     std::unique_ptr<LatentModel> model;
     ToneCurve tone = ToneCurve::Clip;
     int latent_width = 0, latent_height = 0;
