@@ -189,9 +189,8 @@ std::string frame_row(const EditJob& job, EditSession& session, const Tools& t, 
     return row.str();
 }
 
-/// The fit folder's files a frame depends on (manifest, parameters, refiners), and the edit file
-/// unless `with_edits` is false, into a fingerprint.
-Fingerprint fit_and_edits(const EditJob& job, bool with_edits) {
+/// The fit folder's files a frame depends on (manifest, parameters, refiners), into a fingerprint.
+Fingerprint fit_files(const EditJob& job) {
     Fingerprint fingerprint;
     for (const char* file : {"fit.json", "params.json", "refiner.pt"}) {
         const fs::path p = fs::path(job.fitdir) / file;
@@ -200,17 +199,22 @@ Fingerprint fit_and_edits(const EditJob& job, bool with_edits) {
     const fs::path emitters = fs::path(job.fitdir) / kEmitterRefinerFile;
     if (fs::exists(emitters))
         fingerprint.add(read_file(emitters.string()));  // only then: other folders keep their keys
-    fingerprint.add(with_edits ? read_file(job.edits) : std::string("the training view, in any sequence"));
     return fingerprint;
 }
 
-/// What a frame's files depend on besides its index: `files` (fit_and_edits, read once the
-/// session had loaded them) and the render settings, as an FNV-1a hash. frame_NNNN.done starts
+/// `fit` and the edit file; with `with_edits` false the training view's stand-in for it (a frame
+/// that shows the training view does not depend on the edit file).
+Fingerprint and_edits(Fingerprint fit, const EditJob& job, bool with_edits) {
+    fit.add(with_edits ? read_file(job.edits) : std::string("the training view, in any sequence"));
+    return fit;
+}
+
+/// What a frame's files depend on besides its index: `files` (and_edits of fit_files, read once
+/// the session had loaded them) and the render settings, as an FNV-1a hash. frame_NNNN.done starts
 /// with it, so --resume skips a frame only if the same fit and settings made it (a refitted fit,
 /// rerun by a workflow, renders its frames again). A frame that shows the training view does not
 /// depend on the edit file: its name in the frame cache leaves the file out.
-std::string frame_hash(const EditJob& job, const EditSession& session, const Tools& tools, Fingerprint files) {
-    Fingerprint& fingerprint = files;
+std::string frame_hash(const EditJob& job, const EditSession& session, const Tools& tools, Fingerprint fingerprint) {
     auto add = [&fingerprint](const std::string& text) { fingerprint.add(text); };
     for (const auto& [key, value] : job.defines) add(key + "=" + value);
     if (job.sampler) add(std::string("sampler=") + sampler_name(*job.sampler));  // absent: keys as before
@@ -252,9 +256,10 @@ int render_edits(const EditJob& job, const Reporter& report) {
     // The frames' key hashes the fit's files as read around the session's loading of them: a fit
     // or refine writing there meanwhile would give frames of the old files the new files' key,
     // which --resume would then keep.
-    const Fingerprint before = fit_and_edits(job, true);
+    const Fingerprint before = and_edits(fit_files(job), job, true);
     EditSession session(job.fitdir, job.edits, job.defines, job.sampler);
-    const Fingerprint files = fit_and_edits(job, true), files_without_edits = fit_and_edits(job, false);
+    const Fingerprint fit = fit_files(job);
+    const Fingerprint files = and_edits(fit, job, true), files_without_edits = and_edits(fit, job, false);
     if (files.hex() != before.hex())
         throw std::runtime_error(job.fitdir +
                                  ": its files changed while this render loaded them (a fit or refine "
