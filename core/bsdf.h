@@ -144,4 +144,9 @@ public:
 template <int N>
 std::unique_ptr<BSDF<N>> make_bsdf(const Props& props);
 
+/// A scene file's BSDF description, checked as the loaders need it: built once as an RGB BSDF
+/// (each BSDF validates its values), every property read by its constructor (a misspelt key is
+/// an error, not a silent default) and no negative colour. Throws SceneError naming the field.
+void check_bsdf_description(const Props& props);
+
 }  // namespace lpt

@@ -8,8 +8,11 @@ void Props::fail(const std::string& key, const std::string& msg) const {
 }
 
 namespace {
+thread_local PropsReadLog* t_read_log = nullptr;
+
 template <typename T>
 const T* find(const Props& p, const std::string& key, const char* what) {
+    p.mark_queried(key);
     auto it = p.values.find(key);
     if (it == p.values.end()) return nullptr;
     if (auto* v = std::get_if<T>(&it->second)) return v;
@@ -43,6 +46,7 @@ std::string Props::get_string(const std::string& key) const {
     return get_string(key, "");
 }
 Eigen::Array3f Props::get_rgb(const std::string& key, const Eigen::Array3f& def) const {
+    mark_queried(key);
     auto it = values.find(key);
     if (it == values.end()) return def;
     Eigen::Array3f out;
@@ -56,6 +60,17 @@ Eigen::Array3f Props::get_rgb(const std::string& key) const {
     if (!has(key)) fail(key, "required rgb value is missing");
     return get_rgb(key, Eigen::Array3f::Zero());
 }
+Eigen::Array3f Props::get_colour(const std::string& key, const Eigen::Array3f& def) const {
+    const Eigen::Array3f c = get_rgb(key, def);
+    if ((c < 0.f).any())
+        fail(key, "must be >= 0 in every channel, got (" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " +
+                      std::to_string(c[2]) + ")");
+    return c;
+}
+Eigen::Array3f Props::get_colour(const std::string& key) const {
+    if (!has(key)) fail(key, "required rgb value is missing");
+    return get_colour(key, Eigen::Array3f::Zero());
+}
 Transform Props::get_transform(const std::string& key, const Transform& def) const {
     auto* v = find<Transform>(*this, key, "a transform");
     return v ? *v : def;
@@ -63,6 +78,29 @@ Transform Props::get_transform(const std::string& key, const Transform& def) con
 std::shared_ptr<Props> Props::get_child(const std::string& key) const {
     auto* v = find<std::shared_ptr<Props>>(*this, key, "a nested object");
     return v ? *v : nullptr;
+}
+
+void Props::mark_queried(const std::string& key) const {
+    if (t_read_log) t_read_log->note(this, key);
+}
+
+PropsReadLog::PropsReadLog() : m_outer(t_read_log) { t_read_log = this; }
+PropsReadLog::~PropsReadLog() { t_read_log = m_outer; }
+PropsReadLog* PropsReadLog::active() { return t_read_log; }
+
+void PropsReadLog::require_all_read(const Props& props) const {
+    static const std::set<std::string> kNone;
+    auto it = m_read.find(&props);
+    const std::set<std::string>& read = it == m_read.end() ? kNone : it->second;
+    for (const auto& [key, value] : props.values) {
+        if (!read.count(key)) {
+            std::string reads;
+            for (const std::string& k : read) reads += (reads.empty() ? "" : ", ") + k;
+            props.fail(key, "'" + props.type + "' has no property '" + key + "' (it reads " +
+                                (reads.empty() ? std::string("none") : reads) + ")");
+        }
+        if (const auto* child = std::get_if<std::shared_ptr<Props>>(&value); child && *child) require_all_read(**child);
+    }
 }
 
 }  // namespace lpt

@@ -182,6 +182,7 @@ Eigen::Array3f Texture::eval(const Vec2f& uv) const {
 }
 
 Texture texture_from_props(const Props& owner, const std::string& key, const Eigen::Array3f& default_rgb) {
+    owner.mark_queried(key);
     auto it = owner.values.find(key);
     if (it == owner.values.end()) return Texture(default_rgb);
     const PropValue& v = it->second;
@@ -199,9 +200,11 @@ Texture texture_from_props(const Props& owner, const std::string& key, const Eig
         if (auto* s = std::get_if<std::string>(&f->second)) return *s;
         fail_texture_field(owner, key, name, "expected a string");
     };
-    for (const auto& [k, unused] : t.values)
+    for (const auto& [k, unused] : t.values) {
         if (k != "filename" && k != "raw" && k != "filter_type" && k != "wrap_mode")
             fail(k, "bitmap texture does not support '" + k + "' (supported: filename, raw, filter_type, wrap_mode)");
+        t.mark_queried(k);
+    }
 
     if (!t.has("filename")) fail("filename", "a bitmap texture needs a filename");
     fs::path file = str("filename", "");

@@ -24,6 +24,9 @@ Transform Transform::rotate(const Vec3f& axis, float degrees) {
 }
 
 Transform Transform::look_at(const Vec3f& origin, const Vec3f& target, const Vec3f& up) {
+    // Each degenerate case named: all three used to read "'up' is parallel to the view direction".
+    if ((target - origin).norm() == 0.f) throw std::invalid_argument("look_at: 'origin' and 'target' coincide");
+    if (up.norm() == 0.f) throw std::invalid_argument("look_at: 'up' has zero length");
     Vec3f dir = (target - origin).normalized();
     Vec3f left = up.normalized().cross(dir);
     if (left.norm() < 1e-6f) throw std::invalid_argument("look_at: 'up' is parallel to the view direction");

@@ -39,6 +39,7 @@ constexpr NamedIOR kNamedIORs[] = {
 
 float read_ior(const Props& props, const std::string& key, float def) {
     float v = def;
+    props.mark_queried(key);
     auto it = props.values.find(key);
     if (it != props.values.end() && std::holds_alternative<std::string>(it->second)) {
         std::string name = std::get<std::string>(it->second);

@@ -55,6 +55,33 @@ std::unique_ptr<BSDF<N>> make_bsdf(const Props& props) {
                      "unknown BSDF type '" + props.type + "' (known: " + known + ")");
 }
 
+namespace {
+
+/// The colours of a scene file's BSDFs, which must not be negative there (latent BSDFs take
+/// signed values under the same keys, so the BSDFs themselves accept them).
+constexpr const char* kColourKeys[] = {"reflectance", "diffuse_reflectance", "specular_reflectance",
+                                       "specular_transmittance"};
+
+void require_non_negative_colours(const Props& props) {
+    for (const auto& [key, value] : props.values) {
+        if (const auto* child = std::get_if<std::shared_ptr<Props>>(&value)) {
+            if (*child && (*child)->type != "bitmap") require_non_negative_colours(**child);
+            continue;
+        }
+        for (const char* colour : kColourKeys)
+            if (key == colour) props.get_colour(key);
+    }
+}
+
+}  // namespace
+
+void check_bsdf_description(const Props& props) {
+    PropsReadLog read;
+    make_bsdf<3>(props);
+    read.require_all_read(props);
+    require_non_negative_colours(props);
+}
+
 template std::unique_ptr<BSDF<3>> make_bsdf<3>(const Props&);
 template std::unique_ptr<BSDF<16>> make_bsdf<16>(const Props&);
 

@@ -9,7 +9,7 @@ Emitter make_area_emitter(const Props& props, int shape) {
     Emitter e;
     e.kind = EmitterKind::Area;
     e.shape = shape;
-    e.radiance_rgb = props.get_rgb("radiance");
+    e.radiance_rgb = props.get_colour("radiance");
     e.props = props;
     return e;
 }
@@ -19,7 +19,7 @@ Emitter make_environment_emitter(const Props& props) {
     e.props = props;
     if (props.type == "constant") {
         e.kind = EmitterKind::Constant;
-        e.radiance_rgb = props.get_rgb("radiance");
+        e.radiance_rgb = props.get_colour("radiance");
         return e;
     }
     if (props.type != "envmap")

@@ -7,6 +7,7 @@
 #include "core/envmap.h"
 #include "core/texture.h"
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <climits>
 #include <filesystem>
 #include <fstream>
@@ -52,6 +53,20 @@ struct Ctx {
         auto it = obj.find(key);
         return it == obj.end() ? nullptr : &*it;
     }
+    /// An object whose keys are all in `known`: a misspelt key ("max_dept", or one a -D path
+    /// made) would otherwise leave its default in place without a word. Keys that start with
+    /// '_' are comments (the bundled scenes' "_comment").
+    void only_keys(const json& obj, const std::string& field, std::initializer_list<const char*> known) const {
+        if (!obj.is_object()) fail(field, "expected an object, got " + std::string(obj.type_name()));
+        for (const auto& [key, unused] : obj.items()) {
+            if (!key.empty() && key[0] == '_') continue;
+            if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) != known.end())
+                continue;
+            std::string list;
+            for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+            fail(field.empty() ? key : field + "." + key, "unknown key (known here: " + list + ")");
+        }
+    }
 
     Transform transform_op(const json& op, const std::string& field) const {
         if (!op.is_object() || op.size() != 1)
@@ -65,6 +80,7 @@ struct Ctx {
         if (key == "rotate") {
             if (!v.is_object() || !v.contains("axis") || !v.contains("angle"))
                 fail(f, "expected {\"axis\": [x,y,z], \"angle\": degrees}");
+            only_keys(v, f, {"axis", "angle"});
             Vec3f axis = vec3(v["axis"], f + ".axis");
             if (axis.norm() == 0.f) fail(f + ".axis", "axis has zero length");
             return Transform::rotate(axis, number(v["angle"], f + ".angle"));
@@ -73,6 +89,7 @@ struct Ctx {
             if (!v.is_object()) fail(f, "expected {\"origin\", \"target\", \"up\"}");
             for (const char* k : {"origin", "target", "up"})
                 if (!v.contains(k)) fail(f + "." + k, "missing");
+            only_keys(v, f, {"origin", "target", "up"});
             try {
                 return Transform::look_at(vec3(v["origin"], f + ".origin"), vec3(v["target"], f + ".target"),
                                           vec3(v["up"], f + ".up"));
@@ -114,7 +131,7 @@ struct Ctx {
         if (!j.contains("type")) fail(field + ".type", "missing");
         p.type = string(j["type"], field + ".type");
         for (const auto& [k, v] : j.items()) {
-            if (k == "type") continue;
+            if (k == "type" || (!k.empty() && k[0] == '_')) continue;  // '_': a comment
             std::string f = field + "." + k;
             if (v.is_boolean()) p.values[k] = v.get<bool>();
             else if (v.is_number()) p.values[k] = number(v, f);
@@ -155,6 +172,26 @@ bool known_shape_type(const std::string& t) {
 
 bool is_mesh_file(const std::string& t) { return t == "obj" || t == "ply" || t == "gltf"; }
 
+/// A shape's keys: the ones every shape takes and its type's (docs/scene-format.md "shapes").
+void check_shape_keys(const Ctx& c, const json& s, const std::string& f, const std::string& type) {
+    if (type == "obj")
+        c.only_keys(s, f,
+                    {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "filename",
+                     "flip_tex_coords"});
+    else if (is_mesh_file(type))
+        c.only_keys(s, f,
+                    {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "filename"});
+    else if (type == "mesh")
+        c.only_keys(
+            s, f,
+            {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "positions", "indices"});
+    else if (type == "sphere")
+        c.only_keys(
+            s, f,
+            {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "center", "radius"});
+    else c.only_keys(s, f, {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals"});
+}
+
 /// A shape object's placement and file keys as the Props make_shape reads (the rest of the object,
 /// material and emitter, is read by the caller); the filename relative to the scene's folder.
 Props shape_props(const Ctx& c, const json& s, const std::string& f, const std::string& type) {
@@ -167,7 +204,10 @@ Props shape_props(const Ctx& c, const json& s, const std::string& f, const std::
             if (!v->is_boolean()) c.fail(f + "." + key, "expected a boolean");
             p.values[key] = v->get<bool>();
         }
-    if (auto* v = c.opt(s, "flip_tex_coords"); v && v->is_boolean()) p.values["flip_tex_coords"] = v->get<bool>();
+    if (auto* v = c.opt(s, "flip_tex_coords")) {
+        if (!v->is_boolean()) c.fail(f + ".flip_tex_coords", "expected a boolean");
+        p.values["flip_tex_coords"] = v->get<bool>();
+    }
     if (is_mesh_file(type)) {
         if (!s.contains("filename")) c.fail(f + ".filename", "missing");
         p.values["filename"] = (c.dir / c.string(s["filename"], f + ".filename")).string();
@@ -213,6 +253,7 @@ namespace {
 void read_integrator(const Ctx& c, const json& root, IntegratorSettings& s) {
     const json* ij = c.opt(root, "integrator");
     if (!ij) return;
+    c.only_keys(*ij, "integrator", {"max_depth", "rr_depth", "spp", "sampler", "light_sampling"});
     if (auto* v = c.opt(*ij, "max_depth")) s.max_depth = c.integer(*v, "integrator.max_depth");
     if (auto* v = c.opt(*ij, "rr_depth")) s.rr_depth = c.integer(*v, "integrator.rr_depth");
     // the XML loader's ranges
@@ -237,6 +278,8 @@ void read_integrator(const Ctx& c, const json& root, IntegratorSettings& s) {
 void read_camera(const Ctx& c, const json& root, Camera& cam) {
     const json* cj = c.opt(root, "camera");
     if (!cj) c.fail("camera", "missing");
+    c.only_keys(*cj, "camera",
+                {"type", "fov", "fov_axis", "to_world", "width", "height", "near_clip", "far_clip", "filter"});
     if (auto* t = c.opt(*cj, "type"); t && c.string(*t, "camera.type") != "perspective")
         c.fail("camera.type", "unknown camera type '" + t->get<std::string>() + "' (known: perspective)");
     if (auto* v = c.opt(*cj, "fov")) cam.fov = c.number(*v, "camera.fov");
@@ -263,6 +306,7 @@ void read_camera(const Ctx& c, const json& root, Camera& cam) {
         if (ft == "box") cam.filter = {PixelFilter::Type::Box, 0.5f};
         else if (ft == "tent") cam.filter = {PixelFilter::Type::Tent, 1.f};
         else c.fail("camera.filter.type", "expected box or tent");
+        c.only_keys(*f, "camera.filter", {"type", "radius"});
         if (auto* r = c.opt(*f, "radius")) cam.filter.radius = c.number(*r, "camera.filter.radius");
         if (!(cam.filter.radius > 0.f)) c.fail("camera.filter.radius", "must be > 0");
     }
@@ -295,6 +339,7 @@ void read_shapes(const Ctx& c, const json& root, const std::map<std::string, int
         if (!known_shape_type(type))
             c.fail(f + ".type",
                    "unknown shape type '" + type + "' (known: obj, ply, gltf, mesh, rectangle, cube, sphere)");
+        check_shape_keys(c, s, f, type);
         const Props props = shape_props(c, s, f, type);
         Shape shape = type == "mesh" ? make_shape_from_mesh(inline_mesh(c, s, f), props, kJsonShapeDefaults)
                                      : make_shape(props, kJsonShapeDefaults);
@@ -315,7 +360,9 @@ void read_shapes(const Ctx& c, const json& root, const std::map<std::string, int
             if (ep.type != "area")
                 c.fail(f + ".emitter.type", "shapes take emitters of type 'area', got '" + ep.type + "'");
             shape.emitter = int(scene.emitters.size());
+            PropsReadLog read;
             scene.emitters.push_back(make_area_emitter(ep, int(scene.shapes.size())));
+            read.require_all_read(ep);
         }
         scene.shapes.push_back(std::move(shape));
     }
@@ -345,7 +392,9 @@ void read_environment(const Ctx& c, const json& root, Scene& scene) {
                 ep.values["filename"] = fs::absolute(c.dir / name).lexically_normal().string();
                 if (auto* t = c.opt(ejson, "to_world")) ep.values["to_world"] = c.transform(*t, f + ".to_world");
             }
+            PropsReadLog read;
             const Emitter e = make_environment_emitter(ep);
+            read.require_all_read(ep);
             scene.environment = int(scene.emitters.size());
             scene.emitters.push_back(e);
         }
@@ -358,7 +407,7 @@ void validate_materials(const Scene& scene) {
     for (size_t mi = 0; mi < scene.materials.size(); ++mi) {
         const Props& m = scene.materials[mi];
         try {
-            make_bsdf<3>(m);
+            check_bsdf_description(m);
         } catch (const SceneError& e) {
             // Name the shapes too: a material (and its texture) may serve several.
             std::string users;
@@ -384,6 +433,7 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
     }
     if (!root.is_object()) c.fail("", "top level must be an object");
     for (const auto& [k, v] : defines) apply_define(root, k, v, path);
+    c.only_keys(root, "", {"integrator", "camera", "materials", "shapes", "emitters"});
 
     Scene scene;
     scene.file = path;

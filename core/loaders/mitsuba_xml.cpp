@@ -141,7 +141,7 @@ std::shared_ptr<Props> Loader::read_bsdf(const pugi::xml_node& n, const std::str
         if (++nested == 1) props->values["bsdf"] = child;
     }
     try {
-        make_bsdf<3>(*props);
+        check_bsdf_description(*props);
     } catch (const SceneError& e) {
         // A texture under a key the BSDF reads as a plain colour: say so rather than
         // "expected an rgb triple".

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <set>
 
 namespace lpt::mitsuba_xml {
 
@@ -49,7 +50,7 @@ bool is_ident(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c 
 /// replace would turn `$resx` into "64x" when only `res` is defined). A `$` not followed by
 /// an identifier stays literal.
 std::string substitute(const Source& src, const pugi::xml_node& n, const pugi::xml_attribute& a,
-                       const std::map<std::string, std::string>& params) {
+                       const std::map<std::string, std::string>& params, std::set<std::string>& used) {
     std::string in = a.value(), out;
     for (size_t i = 0; i < in.size(); ++i) {
         if (in[i] != '$' || i + 1 >= in.size() || !is_ident(in[i + 1])) {
@@ -64,17 +65,20 @@ std::string substitute(const Source& src, const pugi::xml_node& n, const pugi::x
             src.fail(n, a.name(),
                      "undefined parameter '$" + name + "' in <" + n.name() + ">: declare <default name=\"" + name +
                          "\" value=\"...\"/> or pass it as a define");
+        used.insert(name);
         out += it->second;
         i = j - 1;
     }
     return out;
 }
 
-void substitute_tree(const Source& src, pugi::xml_node n, const std::map<std::string, std::string>& params) {
+void substitute_tree(const Source& src, pugi::xml_node n, const std::map<std::string, std::string>& params,
+                     std::set<std::string>& used) {
     for (pugi::xml_attribute a : n.attributes())
-        if (std::string(a.value()).find('$') != std::string::npos) a.set_value(substitute(src, n, a, params).c_str());
+        if (std::string(a.value()).find('$') != std::string::npos)
+            a.set_value(substitute(src, n, a, params, used).c_str());
     for (pugi::xml_node c : n.children())
-        if (c.type() == pugi::node_element) substitute_tree(src, c, params);
+        if (c.type() == pugi::node_element) substitute_tree(src, c, params, used);
 }
 
 float parse_float_token(const Source& src, const pugi::xml_node& n, const std::string& what, const std::string& tok) {
@@ -165,19 +169,29 @@ Transform transform_op(const Source& src, const pugi::xml_node& op) {
 }  // namespace
 
 void substitute_parameters(const Source& src, pugi::xml_node scene, std::map<std::string, std::string> params) {
+    const std::map<std::string, std::string> defines = params;
+    std::set<std::string> used;  // declared by a <default> or referenced as $name
     for (pugi::xml_node d : scene.children("default")) {
         check_attributes(src, d, {"name", "value"});
         std::string name = required_attribute(src, d, "name");
         if (name.empty()) src.fail(d, "name", "<default> needs a non-empty name");
         required_attribute(src, d, "value");
-        std::string value = substitute(src, d, d.attribute("value"), params);
+        std::string value = substitute(src, d, d.attribute("value"), params, used);
         params.emplace(name, value);  // a define, or an earlier <default> of the same name, wins
+        used.insert(name);
     }
     for (pugi::xml_attribute a : scene.attributes())
         if (std::string(a.value()).find('$') != std::string::npos)
-            a.set_value(substitute(src, scene, a, params).c_str());
+            a.set_value(substitute(src, scene, a, params, used).c_str());
     for (pugi::xml_node c : scene.children())
-        if (c.type() == pugi::node_element && std::string(c.name()) != "default") substitute_tree(src, c, params);
+        if (c.type() == pugi::node_element && std::string(c.name()) != "default") substitute_tree(src, c, params, used);
+    // A define the scene never mentions changes nothing: most likely a misspelt name (-D sppp=64)
+    // or a JSON-style dotted path; say so rather than render with the default.
+    for (const auto& [name, value] : defines)
+        if (!used.count(name))
+            throw SceneError(src.path(), "-D " + name,
+                             "the scene has no parameter '" + name + "' (no <default name=\"" + name + "\"> and no $" +
+                                 name + " in any attribute)");
 }
 
 std::vector<float> parse_floats(const Source& src, const pugi::xml_node& n, const std::string& what,

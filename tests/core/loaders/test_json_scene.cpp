@@ -187,3 +187,94 @@ TEST(JsonScene, NonFinitePropIsAnError) {
         EXPECT_NE(std::string(e.what()).find("materials.m.reflectance"), std::string::npos) << e.what();
     }
 }
+
+TEST(JsonScene, UnknownKeysNameTheirPath) {
+    // A misspelt key left its default in place without a word; now each is an error naming it.
+    const std::pair<std::string, std::string> cases[] = {
+        {scene_json(kWhite, kQuad, R"(, "emiters": [])"), "emiters"},
+        {scene_json(kWhite, kQuad, R"(, "integrator": {"max_dept": 3})"), "integrator.max_dept"},
+        {scene_json(kWhite, R"({"id": "s", "type": "sphere", "material": "white", "radus": 2})"), "shapes[0].radus"},
+        {scene_json(kWhite, R"({"id": "s", "type": "rectangle", "material": "white", "filename": "a.obj"})"),
+         "shapes[0].filename"},
+        {scene_json(kWhite, R"({"id": "s", "type": "cube", "material": "white",
+                               "to_world": {"rotate": {"axis": [0,1,0], "angle": 30, "angel": 3}}})"),
+         "shapes[0].to_world.rotate.angel"},
+    };
+    for (const auto& [json, field] : cases) {
+        const std::string err = load_error("unknown_key.json", json);
+        EXPECT_NE(err.find("unknown_key.json"), std::string::npos) << err;
+        EXPECT_NE(err.find(field), std::string::npos) << field << ": " << err;
+        EXPECT_NE(err.find("unknown key"), std::string::npos) << err;
+    }
+    std::string camera = kCamera;
+    camera.replace(camera.find("\"fov\""), 5, "\"fvo\"");
+    const std::string err = load_error(
+        "camera_key.json", "{" + camera + R"(, "materials": {)" + kWhite + R"(}, "shapes": [)" + kQuad + "]}");
+    EXPECT_NE(err.find("camera.fvo"), std::string::npos) << err;
+    // Keys starting with '_' are comments, as the bundled scenes' "_comment".
+    EXPECT_EQ(load_error("comment.json", scene_json(kWhite, kQuad, R"(, "_comment": "a note")")), "");
+}
+
+TEST(JsonScene, MisspeltDefineIsAnError) {
+    const std::string path = test::write_temp_file("define_typo.json", scene_json(kWhite, kQuad));
+    try {
+        load_scene(path, {{"integrator.max_dept", "3"}});
+        FAIL() << "a -D path the scene has no key for loaded";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("integrator.max_dept"), std::string::npos) << e.what();
+    }
+}
+
+TEST(JsonScene, PropertiesNoReaderAsksForAreErrors) {
+    // Materials: the BSDF's readers decide what it takes.
+    std::string err = load_error("mat_typo.json",
+                                 scene_json(R"("white": {"type": "diffuse", "reflectanse": [0.5, 0.5, 0.5]})", kQuad));
+    EXPECT_NE(err.find("materials.white.reflectanse"), std::string::npos) << err;
+    EXPECT_NE(err.find("it reads reflectance"), std::string::npos) << err;
+    err = load_error("nested_typo.json",
+                     scene_json(R"("white": {"type": "twosided", "bsdf": {"type": "diffuse", "colour": 0.5}})", kQuad));
+    EXPECT_NE(err.find("colour"), std::string::npos) << err;
+    // Emitters likewise.
+    const std::string light =
+        R"({"id": "l", "type": "rectangle", "material": "white", "emitter": {"type": "area", "radiance": 1, "scale": 2}})";
+    err = load_error("emit_typo.json", scene_json(kWhite, light));
+    EXPECT_NE(err.find("shapes[0].emitter.scale"), std::string::npos) << err;
+    // What the readers do ask for still loads, defaults included.
+    EXPECT_EQ(
+        load_error("known.json", scene_json(R"("p": {"type": "plastic", "diffuse_reflectance": 0.3, "int_ior": 1.5})",
+                                            R"({"id": "q", "type": "rectangle", "material": "p"})")),
+        "");
+}
+
+TEST(JsonScene, NegativeColoursAreErrors) {
+    std::string err = load_error("neg_refl.json",
+                                 scene_json(R"("white": {"type": "diffuse", "reflectance": [0.5, -0.1, 0.5]})", kQuad));
+    EXPECT_NE(err.find("materials.white.reflectance"), std::string::npos) << err;
+    EXPECT_NE(err.find(">= 0"), std::string::npos) << err;
+    err = load_error("neg_spec.json", scene_json(R"("glass": {"type": "dielectric", "specular_transmittance": -1})",
+                                                 R"({"id": "q", "type": "rectangle", "material": "glass"})"));
+    EXPECT_NE(err.find("materials.glass.specular_transmittance"), std::string::npos) << err;
+    const std::string light =
+        R"({"id": "l", "type": "rectangle", "material": "white", "emitter": {"type": "area", "radiance": [1, -2, 1]}})";
+    err = load_error("neg_rad.json", scene_json(kWhite, light));
+    EXPECT_NE(err.find("shapes[0].emitter.radiance"), std::string::npos) << err;
+    err = load_error("neg_env.json",
+                     scene_json(kWhite, kQuad, R"(, "emitters": [{"type": "constant", "radiance": -1}])"));
+    EXPECT_NE(err.find("radiance"), std::string::npos) << err;
+    EXPECT_NE(err.find(">= 0"), std::string::npos) << err;
+}
+
+TEST(JsonScene, DegenerateLookatSaysWhy) {
+    const std::pair<std::string, std::string> cases[] = {
+        {R"({"origin": [0,0,1], "target": [0,0,1], "up": [0,1,0]})", "coincide"},
+        {R"({"origin": [0,0,1], "target": [0,0,0], "up": [0,0,0]})", "zero length"},
+        {R"({"origin": [0,0,1], "target": [0,0,0], "up": [0,0,2]})", "parallel"},
+    };
+    for (const auto& [lookat, why] : cases) {
+        const std::string json = R"({"camera": {"to_world": {"lookat": )" + lookat + R"(}}, "materials": {)" + kWhite +
+                                 R"(}, "shapes": [)" + kQuad + "]}";
+        const std::string err = load_error("lookat.json", json);
+        EXPECT_NE(err.find("camera.to_world"), std::string::npos) << err;
+        EXPECT_NE(err.find(why), std::string::npos) << why << ": " << err;
+    }
+}

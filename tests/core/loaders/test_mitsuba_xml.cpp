@@ -38,10 +38,20 @@ TEST(MitsubaXml, DefaultsSubstitutionAndOverride) {
     EXPECT_EQ(s.camera.filter.type, PixelFilter::Type::Tent);
     EXPECT_FLOAT_EQ(s.camera.filter.radius, 1.f);
 
-    Scene o = load_xml("defaults.xml", xml, {{"res", "33"}, {"max_depth", "-1"}, {"unused", "1"}});
+    Scene o = load_xml("defaults.xml", xml, {{"res", "33"}, {"max_depth", "-1"}});
     EXPECT_EQ(o.camera.width, 33);
     EXPECT_EQ(o.integrator.max_depth, -1);
     EXPECT_EQ(o.integrator.spp, 7);
+    // A define the scene neither declares nor references (a typo, a JSON-style path) is an error.
+    for (const char* name : {"unused", "integrator.max_depth"}) {
+        try {
+            load_xml("defaults.xml", xml, {{name, "1"}});
+            ADD_FAILURE() << "-D " << name << " loaded";
+        } catch (const SceneError& e) {
+            expect_has(e.what(), "defaults.xml");
+            expect_has(e.what(), std::string("-D ") + name);
+        }
+    }
 }
 
 TEST(MitsubaXml, MitsubaDefaultsWhenUnset) {
@@ -327,4 +337,36 @@ TEST(MitsubaXml, OldVersionsAndBadBsdfValuesAreErrors) {
     err = load_error("alpha.xml", xml);
     expect_has(err, at_line("alpha.xml", line_of(xml, "roughconductor")));
     expect_has(err, "bsdf 'm'");
+}
+
+TEST(MitsubaXml, BsdfPropertiesNoReaderAsksForAreErrors) {
+    // Mitsuba refuses unreferenced properties too: a typo must not leave the default in place.
+    std::string xml =
+        scene_xml("\n<bsdf type=\"diffuse\" id=\"d\">\n  <rgb name=\"reflectanse\" value=\"0.2\"/>\n</bsdf>\n" + kQuad);
+    std::string err = load_error("typo.xml", xml);
+    expect_has(err, at_line("typo.xml", line_of(xml, "<bsdf")));
+    expect_has(err, "reflectanse");
+    expect_has(err, "it reads reflectance");
+    // Inside a twosided BSDF too.
+    xml = scene_xml(
+        "\n<bsdf type=\"twosided\" id=\"t\"><bsdf type=\"plastic\"><float name=\"int_iro\" value=\"1.5\"/></bsdf>"
+        "</bsdf>\n" +
+        kQuad);
+    expect_has(load_error("nested_typo.xml", xml), "int_iro");
+}
+
+TEST(MitsubaXml, NegativeColoursAreErrors) {
+    std::string xml = scene_xml(
+        "\n<bsdf type=\"conductor\" id=\"c\">\n  <rgb name=\"specular_reflectance\" value=\"1, -1, 1\"/>\n</bsdf>\n" +
+        kQuad);
+    std::string err = load_error("neg_spec.xml", xml);
+    expect_has(err, at_line("neg_spec.xml", line_of(xml, "<bsdf")));
+    expect_has(err, "specular_reflectance");
+    expect_has(err, ">= 0");
+    xml = scene_xml(
+        "\n<shape type=\"rectangle\">\n  <emitter type=\"area\"><rgb name=\"radiance\" value=\"-3\"/></emitter>\n"
+        "</shape>");
+    err = load_error("neg_rad.xml", xml);
+    expect_has(err, "radiance");
+    expect_has(err, ">= 0");
 }
