@@ -35,30 +35,45 @@ struct Cli {
         render->add_option("scene", r.scene, "scene file (.json or Mitsuba 3 .xml), or a fit folder with --edit")
             ->required()
             ->check(CLI::ExistingPath);
-        render
-            ->add_option(
-                "--edit", r.edit,
-                "edits.json: render the fitted latent scene edited (camera, shapes), frame by frame, and decode")
-            ->check(CLI::ExistingFile);
-        render->add_flag("--reference", r.reference,
-                         "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv");
+        auto* edit =
+            render
+                ->add_option(
+                    "--edit", r.edit,
+                    "edits.json: render the fitted latent scene edited (camera, shapes), frame by frame, and decode")
+                ->check(CLI::ExistingFile);
+        // The "with --X" options are refused without --X: alone they would change nothing.
+        auto* reference =
+            render
+                ->add_flag("--reference", r.reference,
+                           "with --edit: also path trace each frame in RGB, encode it, and write metrics.csv")
+                ->needs(edit);
         render->add_option("--ref-spp", r.ref_spp, "with --reference: RGB samples per pixel")
             ->capture_default_str()
-            ->check(positive());
+            ->check(positive())
+            ->needs(reference);
         render
             ->add_option("--ref-seed", r.ref_seed,
                          "with --reference: the references' seed (each edited frame's is made from it and the frame's "
                          "index); another traces independent references (cached apart), e.g. to measure their noise")
-            ->capture_default_str();
-        render->add_option("--reference-cache", r.reference_cache,
-                           "with --reference: keep path-traced frames here and reuse them (keyed by settings, frame)");
-        render->add_option("--frame-cache", r.frame_cache,
-                           "with --edit: keep frames that show the training view (frame 0) here, for other sequences");
-        render->add_option("--frames", r.frames,
-                           "with --edit: only frames A:B (inclusive, from 0), or every S-th of them with A:B:S; split "
-                           "jobs give the same frame files as one, and write metrics_A-B.csv");
-        render->add_flag("--resume", r.resume,
-                         "with --edit: skip frames an earlier, interrupted run finished (frame_NNNN.done)");
+            ->capture_default_str()
+            ->needs(reference);
+        render
+            ->add_option("--reference-cache", r.reference_cache,
+                         "with --reference: keep path-traced frames here and reuse them (keyed by settings, frame)")
+            ->needs(reference);
+        render
+            ->add_option("--frame-cache", r.frame_cache,
+                         "with --edit: keep frames that show the training view (frame 0) here, for other sequences")
+            ->needs(edit);
+        render
+            ->add_option("--frames", r.frames,
+                         "with --edit: only frames A:B (inclusive, from 0), or every S-th of them with A:B:S; split "
+                         "jobs give the same frame files as one, and write metrics_A-B.csv")
+            ->needs(edit);
+        render
+            ->add_flag("--resume", r.resume,
+                       "with --edit: skip frames an earlier, interrupted run finished (frame_NNNN.done)")
+            ->needs(edit);
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
         render->add_option("--spp", r.spp, "samples per pixel (default and 0: the scene's)")->check(non_negative());
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");
@@ -73,9 +88,10 @@ struct Cli {
         render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr");
         render->add_option("--aov-res", r.aov_res, "AOV resolution WxH (default: the image's; latents: image/8)");
         render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")->capture_default_str();
-        render->add_option("-D,--define", defines,
-                           "override a scene value: a key path of a .json scene (-D integrator.max_depth=4), a "
-                           "$parameter of a Mitsuba .xml scene (-D spp=16; a name the file does not use does nothing)");
+        render->add_option(
+            "-D,--define", defines,
+            "override a scene value: a key path of a .json scene (-D integrator.max_depth=4), a "
+            "$parameter of a Mitsuba .xml scene (-D spp=16); a key or name the scene does not have is an error");
         render->add_flag("-q,--quiet", r.quiet, "no progress line");
     }
 
@@ -91,41 +107,52 @@ struct Cli {
             ->capture_default_str()
             ->check(positive());
         bench->add_option("--json", b.out_json, "also write the results as JSON");
-        bench->add_flag("--fit", b.fit, "time fit iterations (forward and adjoint) at latent resolution instead");
-        bench->add_option("--fit-scene", b.fit_scene,
-                          "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)");
+        auto* fit_flag =
+            bench->add_flag("--fit", b.fit, "time fit iterations (forward and adjoint) at latent resolution instead");
+        bench
+            ->add_option("--fit-scene", b.fit_scene,
+                         "scene for --fit (default: ../shared cbox_specular.xml, else the bundled Cornell box)")
+            ->needs(fit_flag);
         bench->add_option("--fit-res", b.fit_res, "latent resolution for --fit")
             ->capture_default_str()
-            ->check(positive());
+            ->check(positive())
+            ->needs(fit_flag);
         bench->add_option("--fit-spp", b.fit_spp, "samples per pixel per iteration for --fit")
             ->capture_default_str()
-            ->check(positive());
-        bench
-            ->add_option("--equal-error", b.equal_error,
-                         "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
-                         "the same latent error, and latent + decode vs RGB for the same image error")
-            ->check(CLI::ExistingDirectory);
+            ->check(positive())
+            ->needs(fit_flag);
+        auto* equal_error =
+            bench
+                ->add_option("--equal-error", b.equal_error,
+                             "fit folder: time for the latent renderer vs RGB path tracing (+ encode) to reach "
+                             "the same latent error, and latent + decode vs RGB for the same image error")
+                ->check(CLI::ExistingDirectory);
         bench->add_option("--max-spp", b.max_spp, "with --equal-error: highest RGB spp (latent side: a quarter)")
             ->capture_default_str()
-            ->check(positive());
-        bench->add_flag("--equal-noise", b.equal_noise,
-                        "spp and render seconds to one noise level, Sobol vs independent sampler, against a converged "
-                        "reference (default scene: ../shared cornell-box scene_v3.xml; docs/sampling.md)");
+            ->check(positive())
+            ->needs(equal_error);
+        auto* equal_noise = bench->add_flag(
+            "--equal-noise", b.equal_noise,
+            "spp and render seconds to one noise level, Sobol vs independent sampler, against a converged "
+            "reference (default scene: ../shared cornell-box scene_v3.xml; docs/sampling.md)");
         bench
             ->add_option("--reference", b.reference,
                          "with --equal-noise: converged reference EXR (default: TungstenRender.exr beside the scene)")
-            ->check(CLI::ExistingFile);
+            ->check(CLI::ExistingFile)
+            ->needs(equal_noise);
         bench
             ->add_option("--target-spp", b.target_spp,
                          "with --equal-noise: target = the independent sampler's noise at this spp (4 ... 256)")
             ->capture_default_str()
-            ->check(CLI::Range(4, 256));
+            ->check(CLI::Range(4, 256))
+            ->needs(equal_noise);
         bench->add_flag("--startup", b.startup,
                         "seconds from exec to exit of --help, a 1-spp 16x16 render and commands that open the "
                         "torch or image plugin (5 x --seeds runs each)");
         bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")
             ->capture_default_str()
-            ->check(positive());
+            ->check(positive())
+            ->needs(equal_noise);
     }
 
     /// The latent model and its objective: what is fitted, and the penalty on it.
@@ -199,19 +226,23 @@ struct Cli {
                         "Equal final loss for K = 0, 1, 8, 32 on the CBox (docs/fitting.md)")
             ->capture_default_str()
             ->check(non_negative());
-        fit->add_flag("--resume", f.job.resume,
-                      "continue from <out>/checkpoint; one made with other settings is an error");
+        auto* resume = fit->add_flag("--resume", f.job.resume,
+                                     "continue from <out>/checkpoint; one made with other settings is an error");
         fit->add_flag("--restart-if-changed", f.job.restart_if_changed,
-                      "with --resume: a checkpoint of other settings is removed and the fit starts again (workflows)");
-        fit->add_flag("--encode", f.job.encode,
-                      "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
+                      "with --resume: a checkpoint of other settings is removed and the fit starts again (workflows)")
+            ->needs(resume);
+        auto* encode = fit->add_flag("--encode", f.job.encode,
+                                     "target = VAE encoding of the scene path traced in RGB (the paper's pipeline)");
         fit->add_option("--encode-res", f.job.encode_res, "image resolution WxH for --encode (latents are 1/8 of it)")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->needs(encode);
         fit->add_option("--ref-spp", f.job.ref_spp, "samples per pixel of the RGB reference for --encode")
             ->capture_default_str()
-            ->check(positive());
+            ->check(positive())
+            ->needs(encode);
         fit->add_option("--reference-cache", f.job.reference_cache,
-                        "with --encode: keep the encoded reference here and reuse it (fits of one scene share it)");
+                        "with --encode: keep the encoded reference here and reuse it (fits of one scene share it)")
+            ->needs(encode);
         fit->add_option("--ref-tone", f.job.ref_tone, "reference tone map: clip or reinhard (then gamma 1/2.2)")
             ->check(CLI::IsMember({"clip", "reinhard"}))
             ->capture_default_str();
@@ -250,10 +281,13 @@ struct Cli {
         add_refine_options(refine, rf.job, "");
         refine->add_option("--seed", rf.job.train.seed, "seed of the initial weights, crops and dropout")
             ->capture_default_str();
-        refine->add_flag("--resume", rf.job.resume,
-                         "continue from <fitdir>/refiner_checkpoint.pt; one trained with other settings is an error");
-        refine->add_flag("--restart-if-changed", rf.job.restart_if_changed,
-                         "with --resume: a checkpoint of other settings is removed and training starts again");
+        auto* resume = refine->add_flag(
+            "--resume", rf.job.resume,
+            "continue from <fitdir>/refiner_checkpoint.pt; one trained with other settings is an error");
+        refine
+            ->add_flag("--restart-if-changed", rf.job.restart_if_changed,
+                       "with --resume: a checkpoint of other settings is removed and training starts again")
+            ->needs(resume);
         refine->add_flag("--emitters", rf.job.emitters,
                          "train refiner_emitters.pt for where edits move emitters (--augment shift; docs/refiner.md)");
         refine->add_flag("-q,--quiet", rf.quiet, "no progress line");

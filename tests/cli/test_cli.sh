@@ -26,6 +26,15 @@ check test -s "$out/r.exr"; check test -s "$out/r.png"; check test -s "$out/r.no
 check cmp -s "$out/define.exr" "$out/flag.exr"
 check sh -c "! cmp -s '$out/define.exr' '$out/nodefine.exr'"
 expect_error "key=value" "$bin" render "$scene" -q -D integrator.max_depth --out "$out/x.exr"
+# A misspelt -D path, or a misspelt key in the file, changed nothing without a word.
+expect_error "integrator.max_dept" "$bin" render "$scene" -q -D integrator.max_dept=2 --out "$out/x.exr"
+# Options that only mean something beside another are refused alone (they did nothing).
+expect_error "requires --edit" "$bin" render "$scene" -q --reference --out "$out/x.exr"
+expect_error "requires --reference" "$bin" render "$scene" -q --ref-spp 8 --out "$out/x.exr"
+expect_error "requires --edit" "$bin" render "$scene" -q --frames 0:1 --out "$out/x.exr"
+expect_error "requires --encode" "$bin" fit "$scene" -q --ref-spp 8 --out "$out/x"
+expect_error "requires --resume" "$bin" fit "$scene" -q --restart-if-changed --out "$out/x"
+expect_error "requires --equal-noise" "$bin" bench --target-spp 8
 
 # Equal-noise bench end to end at toy size against a 64-spp reference, and its missing-reference error.
 "$bin" render "$scene" --spp 64 --res 16x16 -q --out "$out/noise_ref.exr"
