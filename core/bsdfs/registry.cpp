@@ -2,6 +2,7 @@
 // self-registration would vanish from the static library; STYLE.md section 3). Each factory
 // lives in core/bsdfs/<type>.cpp and is explicitly instantiated there for N = 3 and N = 16.
 #include "core/bsdf.h"
+#include "core/texture.h"
 #include <string>
 
 namespace lpt {
@@ -77,7 +78,13 @@ void require_non_negative_colours(const Props& props) {
 
 void check_bsdf_description(const Props& props) {
     PropsReadLog read;
-    make_bsdf<3>(props);
+    try {
+        make_bsdf<3>(props);
+    } catch (const SceneError& e) {
+        // A bitmap under a key the BSDF reads as a plain colour: say so rather than "expected an
+        // rgb triple". Only here: a bitmap under a key nobody reads is a typo (below).
+        throw explain_texture_error(props, e);
+    }
     read.require_all_read(props);
     require_non_negative_colours(props);
 }

@@ -401,8 +401,8 @@ void read_environment(const Ctx& c, const json& root, Scene& scene) {
     }
 }
 
-/// Validates every material once, now, so errors point at the file before rendering starts. A
-/// bitmap under a key its BSDF reads as a plain colour gets a message saying so.
+/// Validates every material once, now, so errors point at the file before rendering starts
+/// (check_bsdf_description: values, unread keys, textures where a plain colour is read).
 void validate_materials(const Scene& scene) {
     for (size_t mi = 0; mi < scene.materials.size(); ++mi) {
         const Props& m = scene.materials[mi];
@@ -413,8 +413,7 @@ void validate_materials(const Scene& scene) {
             std::string users;
             for (const Shape& s : scene.shapes)
                 if (s.material == int(mi)) users += (users.empty() ? "" : ", ") + std::string("'") + s.id + "'";
-            throw explain_texture_error(m, e).with_note(users.empty() ? std::string()
-                                                                      : " (material of shape " + users + ")");
+            throw e.with_note(users.empty() ? std::string() : " (material of shape " + users + ")");
         }
     }
 }

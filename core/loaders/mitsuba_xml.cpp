@@ -143,9 +143,7 @@ std::shared_ptr<Props> Loader::read_bsdf(const pugi::xml_node& n, const std::str
     try {
         check_bsdf_description(*props);
     } catch (const SceneError& e) {
-        // A texture under a key the BSDF reads as a plain colour: say so rather than
-        // "expected an rgb triple".
-        rethrow_at(src, explain_texture_error(*props, e), p.line);
+        rethrow_at(src, e, p.line);
     }
     if (nested > 0 && p.type != "twosided") src.fail(n, p.where, "bsdf '" + p.type + "' does not take a nested BSDF");
     if (nested > 1)

@@ -119,6 +119,11 @@ TEST(MitsubaXml, BitmapTextures) {
     check("texcond.xml",
           in_bsdf("conductor", "<texture type=\"bitmap\" name=\"specular_reflectance\">" + ok_file + "</texture>"),
           "conductor", "textured specular_reflectance on conductor is not supported yet");
+    // A bitmap under a key no reader asks for is a typo, not an unsupported texture.
+    const std::string typo =
+        in_bsdf("diffuse", "<texture type=\"bitmap\" name=\"reflectanse\">" + ok_file + "</texture>");
+    check("textypo.xml", typo, "diffuse", "'diffuse' has no property 'reflectanse'");
+    EXPECT_EQ(load_error("textypo.xml", typo).find("not supported"), std::string::npos);
     // Textures belong to BSDFs only.
     check("texemit.xml",
           scene_xml("\n<shape type=\"rectangle\"><emitter type=\"area\">\n<texture type=\"bitmap\" name=\"radiance\">" +
