@@ -432,6 +432,10 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
     }
     if (!root.is_object()) c.fail("", "top level must be an object");
     for (const auto& [k, v] : defines) apply_define(root, k, v, path);
+    if (root.contains("frames"))  // no scene key: scenes/*/edits-*.json sit beside the scenes
+        c.fail("frames",
+               "this is an edits file, not a scene: render it with `latentpt render <fit folder> --edit "
+               "<this file>`");
     c.only_keys(root, "", {"integrator", "camera", "materials", "shapes", "emitters"});
 
     Scene scene;

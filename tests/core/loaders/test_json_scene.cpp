@@ -211,6 +211,10 @@ TEST(JsonScene, UnknownKeysNameTheirPath) {
     const std::string err = load_error(
         "camera_key.json", "{" + camera + R"(, "materials": {)" + kWhite + R"(}, "shapes": [)" + kQuad + "]}");
     EXPECT_NE(err.find("camera.fvo"), std::string::npos) << err;
+    // An edits file given as a scene says what it is.
+    const std::string edits =
+        load_error("edits.json", R"({"frames": 4, "camera": {"orbit": {"azimuth": [0, 30]}}, "shapes": []})");
+    EXPECT_NE(edits.find("edits.json: field 'frames': this is an edits file"), std::string::npos) << edits;
     // Keys starting with '_' are comments, as the bundled scenes' "_comment".
     EXPECT_EQ(load_error("comment.json", scene_json(kWhite, kQuad, R"(, "_comment": "a note")")), "");
 }
