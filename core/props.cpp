@@ -86,7 +86,6 @@ void Props::mark_queried(const std::string& key) const {
 
 PropsReadLog::PropsReadLog() : m_outer(t_read_log) { t_read_log = this; }
 PropsReadLog::~PropsReadLog() { t_read_log = m_outer; }
-PropsReadLog* PropsReadLog::active() { return t_read_log; }
 
 void PropsReadLog::require_all_read(const Props& props) const {
     static const std::set<std::string> kNone;

@@ -59,7 +59,6 @@ public:
     PropsReadLog(const PropsReadLog&) = delete;
     PropsReadLog& operator=(const PropsReadLog&) = delete;
 
-    static PropsReadLog* active();
     void note(const Props* props, const std::string& key) { m_read[props].insert(key); }
     /// Fails on the first value of `props` that no reader asked for; nested objects that were
     /// read are checked the same way.
