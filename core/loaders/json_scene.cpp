@@ -11,6 +11,7 @@
 #include <climits>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 namespace lpt {
 
@@ -18,6 +19,9 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
+
+/// Keys that start with '_' are comments (the bundled scenes' "_comment"), skipped everywhere.
+bool is_comment_key(const std::string& key) { return !key.empty() && key[0] == '_'; }
 
 struct Ctx {
     std::string file;
@@ -53,13 +57,12 @@ struct Ctx {
         auto it = obj.find(key);
         return it == obj.end() ? nullptr : &*it;
     }
-    /// An object whose keys are all in `known`: a misspelt key ("max_dept", or one a -D path
-    /// made) would otherwise leave its default in place without a word. Keys that start with
-    /// '_' are comments (the bundled scenes' "_comment").
-    void only_keys(const json& obj, const std::string& field, std::initializer_list<const char*> known) const {
+    /// An object whose keys are all in `known` or comments: a misspelt key ("max_dept", or one a
+    /// -D path made) would otherwise leave its default in place without a word.
+    void only_keys(const json& obj, const std::string& field, const std::vector<const char*>& known) const {
         if (!obj.is_object()) fail(field, "expected an object, got " + std::string(obj.type_name()));
         for (const auto& [key, unused] : obj.items()) {
-            if (!key.empty() && key[0] == '_') continue;
+            if (is_comment_key(key)) continue;
             if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) != known.end())
                 continue;
             std::string list;
@@ -131,7 +134,7 @@ struct Ctx {
         if (!j.contains("type")) fail(field + ".type", "missing");
         p.type = string(j["type"], field + ".type");
         for (const auto& [k, v] : j.items()) {
-            if (k == "type" || (!k.empty() && k[0] == '_')) continue;  // '_': a comment
+            if (k == "type" || is_comment_key(k)) continue;
             std::string f = field + "." + k;
             if (v.is_boolean()) p.values[k] = v.get<bool>();
             else if (v.is_number()) p.values[k] = number(v, f);
@@ -174,22 +177,12 @@ bool is_mesh_file(const std::string& t) { return t == "obj" || t == "ply" || t =
 
 /// A shape's keys: the ones every shape takes and its type's (docs/scene-format.md "shapes").
 void check_shape_keys(const Ctx& c, const json& s, const std::string& f, const std::string& type) {
-    if (type == "obj")
-        c.only_keys(s, f,
-                    {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "filename",
-                     "flip_tex_coords"});
-    else if (is_mesh_file(type))
-        c.only_keys(s, f,
-                    {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "filename"});
-    else if (type == "mesh")
-        c.only_keys(
-            s, f,
-            {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "positions", "indices"});
-    else if (type == "sphere")
-        c.only_keys(
-            s, f,
-            {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals", "center", "radius"});
-    else c.only_keys(s, f, {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals"});
+    std::vector<const char*> keys = {"id", "type", "material", "emitter", "to_world", "face_normals", "flip_normals"};
+    if (type == "obj") keys.insert(keys.end(), {"filename", "flip_tex_coords"});
+    else if (is_mesh_file(type)) keys.push_back("filename");
+    else if (type == "mesh") keys.insert(keys.end(), {"positions", "indices"});
+    else if (type == "sphere") keys.insert(keys.end(), {"center", "radius"});
+    c.only_keys(s, f, keys);
 }
 
 /// A shape object's placement and file keys as the Props make_shape reads (the rest of the object,
