@@ -1,5 +1,6 @@
 #include "core/scene_edit.h"
 #include "core/error.h"
+#include "core/json_keys.h"
 #include <nlohmann/json.hpp>
 #include <cmath>
 #include <fstream>
@@ -23,20 +24,29 @@ struct Parser {
     [[noreturn]] void fail(const std::string& field, const std::string& msg) const {
         throw SceneError(file, field, msg);
     }
+    /// "azimut" would otherwise leave the camera where it is for every frame without a word.
+    void only_keys(const json& obj, const std::string& field, const std::vector<const char*>& known) const {
+        require_known_keys(obj, file, field, known);
+    }
+    float number(const json& j, const std::string& field) const {
+        if (!j.is_number()) fail(field, "expected a number");
+        const float v = j.get<float>();  // 1e39 is a JSON number and an infinite float
+        if (!std::isfinite(v)) fail(field, "value is not finite");
+        return v;
+    }
 
     Vec3f vec(const json& j, const std::string& field, bool scalar_ok) const {
         if (j.is_number()) {
             if (!scalar_ok) fail(field, "expected [x, y, z]");
-            return Vec3f::Constant(j.get<float>());
+            return Vec3f::Constant(number(j, field));
         }
         if (!j.is_array() || j.size() != 3)
             fail(field, scalar_ok ? "expected a number or [x, y, z]" : "expected [x, y, z]");
         Vec3f v;
         for (int i = 0; i < 3; ++i) {
             if (!j[i].is_number()) fail(field, "expected numbers");
-            v[i] = j[i].get<float>();
+            v[i] = number(j[i], field);
         }
-        if (!v.allFinite()) fail(field, "value is not finite");
         return v;
     }
     enum class Kind { Scalar, Vector, Scale };
@@ -45,10 +55,7 @@ struct Parser {
     /// list of those, where a list of exactly three numbers reads as one [x,y,z].
     Track track(const json& j, const std::string& field, Kind kind) const {
         auto one = [&](const json& v, const std::string& f) {
-            if (kind == Kind::Scalar) {
-                if (!v.is_number()) fail(f, "expected a number");
-                return Vec3f(v.get<float>(), 0.f, 0.f);
-            }
+            if (kind == Kind::Scalar) return Vec3f(number(v, f), 0.f, 0.f);
             return vec(v, f, kind == Kind::Scale);
         };
         bool keyframes = false;
@@ -75,8 +82,11 @@ Eigen::AlignedBox3f bounds(const TriangleMesh& m) {
 
 CameraEdit read_camera_edit(const Parser& p, const json& c, const Scene& scene) {
     CameraEdit cam;
+    p.only_keys(c, "camera", {"orbit", "lookat"});
+    if (c.contains("orbit") && c.contains("lookat")) p.fail("camera", "expected orbit or lookat, not both");
     if (c.contains("orbit")) {
         const json& o = c["orbit"];
+        p.only_keys(o, "camera.orbit", {"azimuth", "elevation", "pivot", "up"});
         cam.kind = CameraEdit::Kind::Orbit;
         cam.azimuth = o.contains("azimuth") ? p.track(o["azimuth"], "camera.orbit.azimuth", Parser::Kind::Scalar)
                                             : Track{{Vec3f::Zero()}};
@@ -84,9 +94,14 @@ CameraEdit read_camera_edit(const Parser& p, const json& c, const Scene& scene) 
                             ? p.track(o["elevation"], "camera.orbit.elevation", Parser::Kind::Scalar)
                             : Track{{Vec3f::Zero()}};
         cam.pivot = o.contains("pivot") ? p.vec(o["pivot"], "camera.orbit.pivot", false) : scene.bounds_center();
-        if (o.contains("up")) cam.up = p.vec(o["up"], "camera.orbit.up", false).normalized();
+        if (o.contains("up")) {
+            cam.up = p.vec(o["up"], "camera.orbit.up", false);
+            if (cam.up.norm() == 0.f) p.fail("camera.orbit.up", "zero vector");
+            cam.up.normalize();
+        }
     } else if (c.contains("lookat")) {
         const json& l = c["lookat"];
+        p.only_keys(l, "camera.lookat", {"origin", "target", "up"});
         cam.kind = CameraEdit::Kind::LookAt;
         for (const char* k : {"origin", "target", "up"})
             if (!l.contains(k)) p.fail(std::string("camera.lookat.") + k, "missing");
@@ -105,7 +120,8 @@ std::vector<ShapeEdit> read_shape_edits(const Parser& p, const json& list, const
     for (size_t i = 0; i < list.size(); ++i) {
         const json& s = list[i];
         const std::string f = "shapes[" + std::to_string(i) + "]";
-        if (!s.is_object() || !s.contains("id") || !s["id"].is_string()) p.fail(f + ".id", "missing shape id");
+        p.only_keys(s, f, {"id", "translate", "rotate", "scale", "pivot"});
+        if (!s.contains("id") || !s["id"].is_string()) p.fail(f + ".id", "missing shape id");
         ShapeEdit e;
         e.id = s["id"].get<std::string>();
         e.shape = scene.find_shape(e.id);
@@ -116,7 +132,8 @@ std::vector<ShapeEdit> read_shape_edits(const Parser& p, const json& list, const
         e.rotate_angle = Track{{Vec3f::Zero()}};
         if (s.contains("rotate")) {
             const json& r = s["rotate"];
-            if (!r.is_object() || !r.contains("angle"))
+            p.only_keys(r, f + ".rotate", {"axis", "angle"});
+            if (!r.contains("angle"))
                 p.fail(f + ".rotate", "expected {\"axis\": [x,y,z], \"angle\": degrees or keyframes}");
             if (r.contains("axis")) e.rotate_axis = p.vec(r["axis"], f + ".rotate.axis", false);
             if (e.rotate_axis.norm() == 0.f) p.fail(f + ".rotate.axis", "zero axis");
@@ -127,9 +144,6 @@ std::vector<ShapeEdit> read_shape_edits(const Parser& p, const json& list, const
             e.pivot = p.track(s["pivot"], f + ".pivot", Parser::Kind::Vector);
             e.has_pivot = true;
         }
-        for (const auto& [key, v] : s.items())
-            if (key != "id" && key != "translate" && key != "scale" && key != "rotate" && key != "pivot")
-                p.fail(f + "." + key, "unknown key (known: id, translate, rotate, scale, pivot)");
         out.push_back(e);
     }
     return out;
@@ -149,9 +163,7 @@ EditSequence load_edits(const std::string& path, const Scene& scene) {
     }
     if (!j.is_object()) p.fail("", "top level must be an object");
     EditSequence seq;
-    for (const auto& [key, v] : j.items())
-        if (key != "frames" && key != "camera" && key != "shapes")
-            p.fail(key, "unknown key (known: frames, camera, shapes)");
+    p.only_keys(j, "", {"frames", "camera", "shapes"});
     if (j.contains("frames")) {
         // read as int64 first: get<int>() of 4294967297 wrapped to 1
         const json& f = j["frames"];

@@ -2,6 +2,7 @@
 // field, e.g. `scene.json: field 'shapes[2].material': unknown material 'whte'`.
 #include "core/bsdf.h"
 #include "core/error.h"
+#include "core/json_keys.h"
 #include "core/scene_loader.h"
 #include "core/shape_factory.h"
 #include "core/envmap.h"
@@ -19,9 +20,6 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Keys that start with '_' are comments (the bundled scenes' "_comment"), skipped everywhere.
-bool is_comment_key(const std::string& key) { return !key.empty() && key[0] == '_'; }
 
 struct Ctx {
     std::string file;
@@ -57,18 +55,9 @@ struct Ctx {
         auto it = obj.find(key);
         return it == obj.end() ? nullptr : &*it;
     }
-    /// An object whose keys are all in `known` or comments: a misspelt key ("max_dept", or one a
-    /// -D path made) would otherwise leave its default in place without a word.
+    /// A -D path with a typo makes an unknown key too, so it fails here as well.
     void only_keys(const json& obj, const std::string& field, const std::vector<const char*>& known) const {
-        if (!obj.is_object()) fail(field, "expected an object, got " + std::string(obj.type_name()));
-        for (const auto& [key, unused] : obj.items()) {
-            if (is_comment_key(key)) continue;
-            if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) != known.end())
-                continue;
-            std::string list;
-            for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-            fail(field.empty() ? key : field + "." + key, "unknown key (known here: " + list + ")");
-        }
+        require_known_keys(obj, file, field, known);
     }
 
     Transform transform_op(const json& op, const std::string& field) const {

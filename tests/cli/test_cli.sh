@@ -88,6 +88,9 @@ expect_error "A:B" "$bin" render "$out/fit" --edit "$edits" --frames 5 -q --out 
 check test "$(ls "$out/edit_step" | grep -c 'done$')" -eq 3
 for i in 0000 0003 0006; do check cmp "$out/edit_all/frame_$i.png" "$out/edit_step/frame_$i.png"; done
 expect_error "A:B:S" "$bin" render "$out/fit" --edit "$edits" --frames 0:7:0 -q --out "$out/x"
+# A misspelt key in an edits file fails naming it (it used to render an unmoved camera).
+printf '{"frames": 2, "camera": {"orbit": {"azimut": [0, 30]}}}' > "$out/typo-edits.json"
+expect_error "camera.orbit.azimut" "$bin" render "$out/fit" --edit "$out/typo-edits.json" -q --out "$out/x"
 
 expect_error "channels" "$bin" fit "$scene" --target "$out/r.exr" -q --out "$out/bad"
 expect_error "does not exist" "$bin" render "$out/missing.json" -q --out "$out/x.exr"

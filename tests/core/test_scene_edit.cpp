@@ -94,6 +94,33 @@ TEST(SceneEdit, ErrorsNameFileAndField) {
     EXPECT_NE(edit_error(s, R"({"frames": )").find("malformed"), std::string::npos);
 }
 
+// A misspelt key used to leave its default in place: "azimut" rendered 60 frames of an unmoved
+// camera. Every object of the format now names its unknown key; '_' keys stay comments.
+TEST(SceneEdit, MisspeltKeysAreErrorsEverywhere) {
+    Scene s = cornell();
+    const auto fails_at = [&](const std::string& json, const std::string& field) {
+        const std::string err = edit_error(s, json);
+        EXPECT_NE(err.find("field '" + field + "'"), std::string::npos) << json << " -> " << err;
+        return err;
+    };
+    EXPECT_NE(fails_at(R"({"camera": {"orbit": {"azimut": [0, 30]}}})", "camera.orbit.azimut").find("azimuth"),
+              std::string::npos);
+    fails_at(R"({"camera": {"lookat": {"origin": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40}}})",
+             "camera.lookat.fov");
+    fails_at(R"({"camera": {"orbit": {"azimuth": 10}, "zoom": 2}})", "camera.zoom");
+    fails_at(R"({"camera": {"orbit": {"azimuth": 10}, "lookat": {}}})", "camera");
+    fails_at(R"({"camera": {"orbit": 30}})", "camera.orbit");
+    fails_at(R"({"camera": {"orbit": {"up": [0, 0, 0]}}})", "camera.orbit.up");
+    fails_at(R"({"shapes": [{"id": "light", "rotate": {"axis": [0, 1, 0], "angle": 10, "degrees": 1}}]})",
+             "shapes[0].rotate.degrees");
+    fails_at(R"({"shapes": [{"id": "light", "translate": [1, 0, 0], "scael": 2}]})", "shapes[0].scael");
+    fails_at(R"({"frames": 2, "frame": 3})", "frame");
+    fails_at(R"({"shapes": [{"id": "light", "translate": [1e39, 0, 0]}]})", "shapes[0].translate");
+    fails_at(R"({"camera": {"orbit": {"azimuth": [0, 1e39]}}})", "camera.orbit.azimuth[1]");
+    fails_at(R"({"shapes": [{"id": "light", "scale": 1e39}]})", "shapes[0].scale");
+    EXPECT_EQ(edit_error(s, R"({"_comment": "x", "camera": {"orbit": {"_why": "y", "azimuth": 10}}})"), "");
+}
+
 TEST(SceneEdit, UneditedOnlyWhereEveryTrackIsItsIdentity) {
     Scene s = cornell();
     EditSequence e = load_edits(test::write_temp_file("e3.json", R"({"frames": 4, "shapes": [
