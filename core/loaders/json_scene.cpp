@@ -366,9 +366,7 @@ void read_environment(const Ctx& c, const json& root, Scene& scene) {
             if (scene.environment >= 0) c.fail(f, "only one environment emitter is supported");
             if (ep.type == "envmap") {
                 // {"type": "envmap", "filename": "sky.exr", "scale": 1, "to_world": ...}
-                for (const auto& [k, v] : ejson.items())
-                    if (k != "type" && k != "filename" && k != "scale" && k != "to_world")
-                        c.fail(f + "." + k, "unknown envmap key (filename, scale, to_world)");
+                c.only_keys(ejson, f, {"type", "filename", "scale", "to_world"});
                 const std::string name = ep.get_string("filename", "");
                 if (name.empty()) c.fail(f + ".filename", "missing");
                 ep.values["filename"] = fs::absolute(c.dir / name).lexically_normal().string();

@@ -199,6 +199,8 @@ TEST(JsonScene, UnknownKeysNameTheirPath) {
         {scene_json(kWhite, R"({"id": "s", "type": "cube", "material": "white",
                                "to_world": {"rotate": {"axis": [0,1,0], "angle": 30, "angel": 3}}})"),
          "shapes[0].to_world.rotate.angel"},
+        {scene_json(kWhite, kQuad, R"(, "emitters": [{"type": "envmap", "filenme": "sky.exr"}])"),
+         "emitters[0].filenme"},
     };
     for (const auto& [json, field] : cases) {
         const std::string err = load_error("unknown_key.json", json);
