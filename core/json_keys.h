@@ -19,8 +19,7 @@ inline void require_known_keys(const nlohmann::json& obj, const std::string& fil
     if (!obj.is_object()) throw SceneError(file, field, "expected an object, got " + std::string(obj.type_name()));
     for (const auto& [key, unused] : obj.items()) {
         if (is_comment_key(key)) continue;
-        if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) != known.end())
-            continue;
+        if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) != known.end()) continue;
         std::string list;
         for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
         throw SceneError(file, field.empty() ? key : field + "." + key, "unknown key (known here: " + list + ")");
