@@ -1,4 +1,5 @@
 #include "vae/vae_config.h"
+#include "core/json_keys.h"
 #include "core/json_number.h"
 #include <cmath>
 #include <fstream>
@@ -25,6 +26,10 @@ VaeConfig parse_vae_config(const std::string& text, const std::string& path) {
         throw std::runtime_error(path + ": malformed JSON: " + e.what());
     }
     if (!j.is_object()) throw std::runtime_error(path + ": expected a JSON object");
+    // Every field but "name" (a description the exporters write) is required, so a misspelt one
+    // fails as missing; an extra one (diffusers' "scaling_factor" beside "scale") would otherwise
+    // pass as if it were read.
+    require_known_keys(j, path, "", {"name", "channels", "downsample", "scale", "shift", "image_range", "latent"});
     auto field = [&](const char* k) -> const nlohmann::json& {
         if (!j.contains(k)) throw std::runtime_error(path + ": missing field '" + k + "'");
         return j[k];

@@ -117,6 +117,9 @@ TEST(TorchScriptVae, BadFilesAndConfigsNameTheProblem) {
     std::ofstream(cfg)
         << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1], "latent": "weird"})";
     expect_error("e.pt", "d.pt", cfg, "latent");
+    std::ofstream(cfg) << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1],
+                             "latent": "raw", "scaling_factor": 1.5})";
+    expect_error("e.pt", "d.pt", cfg, "field 'scaling_factor': unknown key");
     std::ofstream(cfg)
         << R"({"channels": 16, "downsample": 8, "scale": 1.5, "shift": 0.1, "image_range": [0, 1], "latent": "raw"})";
     expect_error((d / "missing.pt").string(), junk, cfg, "missing.pt");
