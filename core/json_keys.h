@@ -4,6 +4,7 @@
 #pragma once
 #include "core/error.h"
 #include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -24,6 +25,15 @@ inline void require_known_keys(const nlohmann::json& obj, const std::string& fil
         for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
         throw SceneError(file, field.empty() ? key : field + "." + key, "unknown key (known here: " + list + ")");
     }
+}
+
+/// `j` as a float: SceneError naming `file` and `field` unless it is a JSON number that a float
+/// holds finitely (1e39 is valid JSON and an infinite float).
+inline float require_finite_number(const nlohmann::json& j, const std::string& file, const std::string& field) {
+    if (!j.is_number()) throw SceneError(file, field, "expected a number, got " + std::string(j.type_name()));
+    const float v = j.get<float>();
+    if (!std::isfinite(v)) throw SceneError(file, field, "value is not finite");
+    return v;
 }
 
 }  // namespace lpt

@@ -2,7 +2,6 @@
 #include "core/error.h"
 #include "core/json_keys.h"
 #include <nlohmann/json.hpp>
-#include <cmath>
 #include <fstream>
 
 namespace lpt {
@@ -28,12 +27,7 @@ struct Parser {
     void only_keys(const json& obj, const std::string& field, const std::vector<const char*>& known) const {
         require_known_keys(obj, file, field, known);
     }
-    float number(const json& j, const std::string& field) const {
-        if (!j.is_number()) fail(field, "expected a number");
-        const float v = j.get<float>();  // 1e39 is a JSON number and an infinite float
-        if (!std::isfinite(v)) fail(field, "value is not finite");
-        return v;
-    }
+    float number(const json& j, const std::string& field) const { return require_finite_number(j, file, field); }
 
     Vec3f vec(const json& j, const std::string& field, bool scalar_ok) const {
         if (j.is_number()) {
@@ -43,10 +37,7 @@ struct Parser {
         if (!j.is_array() || j.size() != 3)
             fail(field, scalar_ok ? "expected a number or [x, y, z]" : "expected [x, y, z]");
         Vec3f v;
-        for (int i = 0; i < 3; ++i) {
-            if (!j[i].is_number()) fail(field, "expected numbers");
-            v[i] = number(j[i], field);
-        }
+        for (int i = 0; i < 3; ++i) v[i] = number(j[i], field);
         return v;
     }
     enum class Kind { Scalar, Vector, Scale };

@@ -8,7 +8,6 @@
 #include "core/envmap.h"
 #include "core/texture.h"
 #include <nlohmann/json.hpp>
-#include <algorithm>
 #include <climits>
 #include <filesystem>
 #include <fstream>
@@ -28,12 +27,7 @@ struct Ctx {
         throw SceneError(file, field, msg);
     }
 
-    float number(const json& j, const std::string& field) const {
-        if (!j.is_number()) fail(field, "expected a number, got " + std::string(j.type_name()));
-        float v = j.get<float>();
-        if (!std::isfinite(v)) fail(field, "value is not finite");
-        return v;
-    }
+    float number(const json& j, const std::string& field) const { return require_finite_number(j, file, field); }
     Vec3f vec3(const json& j, const std::string& field) const {
         if (j.is_number()) return Vec3f::Constant(number(j, field));
         if (!j.is_array() || j.size() != 3) fail(field, "expected an array of 3 numbers");

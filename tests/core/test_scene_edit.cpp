@@ -118,6 +118,10 @@ TEST(SceneEdit, MisspeltKeysAreErrorsEverywhere) {
     fails_at(R"({"shapes": [{"id": "light", "translate": [1e39, 0, 0]}]})", "shapes[0].translate");
     fails_at(R"({"camera": {"orbit": {"azimuth": [0, 1e39]}}})", "camera.orbit.azimuth[1]");
     fails_at(R"({"shapes": [{"id": "light", "scale": 1e39}]})", "shapes[0].scale");
+    // The scene reader's words for a wrong type (one number check serves both formats).
+    EXPECT_NE(fails_at(R"({"shapes": [{"id": "light", "translate": [1, "0", 0]}]})", "shapes[0].translate")
+                  .find("expected a number, got string"),
+              std::string::npos);
     EXPECT_EQ(edit_error(s, R"({"_comment": "x", "camera": {"orbit": {"_why": "y", "azimuth": 10}}})"), "");
 }
 
