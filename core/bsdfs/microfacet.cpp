@@ -120,6 +120,9 @@ float MicrofacetDistribution::sample_weight(const Vec3f& wi, const Vec3f& wo, co
 }
 
 MicrofacetType read_distribution(const Props& props) {
+    // Mitsuba's sample_visible picks how normals are sampled, not what the BSDF is: read (so a
+    // scene that sets it loads) and ignored (docs/bsdfs.md "Deviations from Mitsuba 3").
+    (void)props.get_bool("sample_visible", true);
     std::string name = props.get_string("distribution", "beckmann");
     if (name == "beckmann") return MicrofacetType::Beckmann;
     if (name == "ggx") return MicrofacetType::GGX;

@@ -7,7 +7,8 @@
 // Smith G1 is exact for both (Beckmann via erfc, not Walter's rational fit).
 // Keys (read by read_distribution / read_alpha): distribution "beckmann"|"ggx" (default
 // beckmann, as Mitsuba 3); alpha (float, default 0.1, > 0; roughness = RMS slope for Beckmann;
-// values below 1e-4 are raised to 1e-4 as in Mitsuba 3). Equations: docs/bsdfs.md (5)-(12).
+// values below 1e-4 are raised to 1e-4 as in Mitsuba 3); sample_visible (bool, read and
+// ignored: GGX always samples visible normals, Beckmann never). Equations: docs/bsdfs.md (5)-(12).
 // Roughness derivatives ∂D/∂α, ∂G1/∂α, ∂G/∂α (analytic, exact): docs/bsdfs.md (37)-(39).
 #pragma once
 #include "core/geometry.h"

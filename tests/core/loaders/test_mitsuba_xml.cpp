@@ -123,6 +123,7 @@ TEST(MitsubaXml, RefsNestedAndTwosidedBsdfs) {
   </bsdf>
   <bsdf type="roughconductor" id="metal">
     <float name="alpha" value="0.25"/><string name="distribution" value="beckmann"/>
+    <boolean name="sample_visible" value="false"/>
     <rgb name="eta" value="2.8656, 2.11918, 1.94008"/><rgb name="k" value="3.03233, 2.05611, 1.61629"/>
   </bsdf>
   <shape type="rectangle" id="a"><ref id="white"/></shape>
@@ -143,6 +144,7 @@ TEST(MitsubaXml, RefsNestedAndTwosidedBsdfs) {
     EXPECT_EQ(metal.type, "roughconductor");
     EXPECT_EQ(metal.get_string("distribution"), "beckmann");
     EXPECT_FLOAT_EQ(metal.get_float("alpha"), 0.25f);
+    EXPECT_FALSE(metal.get_bool("sample_visible", true));  // Mitsuba's sampling switch loads (ignored)
     const Props& glass = s.materials[s.shapes[3].material];
     EXPECT_EQ(glass.type, "dielectric");
     EXPECT_FLOAT_EQ(glass.get_float("int_ior"), 1.5f);
