@@ -134,20 +134,32 @@ struct Ctx {
     }
 };
 
+/// The element of array `node` that path part `part` ("0", "12") names; SceneError otherwise.
+json& array_element(json& node, const std::string& part, const std::string& key, const std::string& file) {
+    const bool digits = !part.empty() && part.size() <= 9 && part.find_first_not_of("0123456789") == std::string::npos;
+    if (!digits || std::stoul(part) >= node.size())
+        throw SceneError(
+            file, key, "cannot override: '" + part + "' is not an index of an array of " + std::to_string(node.size()));
+    return node[std::stoul(part)];
+}
+
 void apply_define(json& root, const std::string& key, const std::string& value, const std::string& file) {
-    // "integrator.spp=64": walk the object path, parse the value as JSON (fallback: string).
+    // "integrator.spp=64", "shapes.2.material=red": walk the path (array elements by index),
+    // parse the value as JSON (fallback: string).
     json* node = &root;
     size_t start = 0;
     while (true) {
-        size_t dot = key.find('.', start);
-        std::string part = key.substr(start, dot - start);
+        const size_t dot = key.find('.', start);
+        const std::string part = key.substr(start, dot - start);
+        if (!node->is_object() && !node->is_array() && !node->is_null())
+            throw SceneError(file, key, "cannot override: not an object path");
+        json& child = node->is_array() ? array_element(*node, part, key, file) : (*node)[part];
         if (dot == std::string::npos) {
             json v = json::parse(value, nullptr, false);
-            (*node)[part] = v.is_discarded() ? json(value) : v;
+            child = v.is_discarded() ? json(value) : v;
             return;
         }
-        if (!node->is_object()) throw SceneError(file, key, "cannot override: not an object path");
-        node = &(*node)[part];
+        node = &child;
         start = dot + 1;
     }
 }

@@ -6,6 +6,7 @@
 #include "core/scene_loader.h"
 #include "test_util.h"
 #include <gtest/gtest.h>
+#include <regex>
 
 using namespace lpt;
 
@@ -53,6 +54,21 @@ TEST(JsonScene, DefinesOverrideValues) {
     Scene s = load_scene(path, {{"integrator.spp", "7"}, {"camera.width", "33"}});
     EXPECT_EQ(s.integrator.spp, 7);
     EXPECT_EQ(s.camera.width, 33);
+    // Array elements by index: a shape's material, one component of a colour.
+    const std::string two = test::write_temp_file(
+        "defines2.json",
+        scene_json(kWhite + R"(, "grey": {"type": "diffuse", "reflectance": [0.2, 0.2, 0.2]})",
+                   kQuad + ", " + std::regex_replace(kQuad, std::regex(R"("id": "q")"), R"("id": "q2")")));
+    s = load_scene(two, {{"shapes.1.material", "grey"}, {"materials.white.reflectance.1", "0.25"}});
+    EXPECT_EQ(s.materials[s.shapes[0].material].get_rgb("reflectance").y(), 0.25f);
+    EXPECT_NE(s.shapes[0].material, s.shapes[1].material);
+    EXPECT_EQ(s.materials[s.shapes[1].material].get_rgb("reflectance").y(), 0.2f);
+    for (const char* bad : {"shapes.2.material", "shapes.x.material", "shapes.-1.material", "camera.fov.x"}) try {
+            load_scene(two, {{bad, "grey"}});
+            ADD_FAILURE() << bad << " loaded";
+        } catch (const SceneError& e) {
+            EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << bad << ": " << e.what();
+        }
 }
 
 TEST(JsonScene, TransformListComposesInOrder) {
