@@ -75,7 +75,8 @@ struct Cli {
                        "with --edit: skip frames an earlier, interrupted run finished (frame_NNNN.done)")
             ->needs(edit);
         render->add_option("-o,--out", r.out, "output EXR path; the PNG preview goes beside it")->capture_default_str();
-        render->add_option("--spp", r.spp, "samples per pixel (default and 0: the scene's)")->check(non_negative());
+        render->add_option("--spp", r.spp, "samples per pixel (default and 0: the scene's; with --edit 64)")
+            ->check(non_negative());
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");
         render->add_option("--seed", r.seed, "random seed: same seed, same image, at any thread count")
             ->capture_default_str();
@@ -148,7 +149,7 @@ struct Cli {
             ->needs(equal_noise);
         bench->add_flag("--startup", b.startup,
                         "seconds from exec to exit of --help, a 1-spp 16x16 render and commands that open the "
-                        "torch or image plugin (5 x --seeds runs each)");
+                        "torch or image plugin (median and minimum of 10 runs each)");
         bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")
             ->capture_default_str()
             ->check(positive())
