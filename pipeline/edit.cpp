@@ -251,6 +251,13 @@ std::optional<std::string> finished_row(const fs::path& done, const std::string&
 }  // namespace
 
 int render_edits(const EditJob& job, const Reporter& report) {
+    // The CLI checks these; Python's render_edits does not (spp 0 rendered black frames).
+    if (job.spp < 1) throw std::invalid_argument("edit spp must be > 0, got " + std::to_string(job.spp));
+    if (job.reference && job.ref_spp < 1)
+        throw std::invalid_argument("edit ref_spp must be > 0, got " + std::to_string(job.ref_spp));
+    if (job.width < 0 || job.height < 0)
+        throw std::invalid_argument("edit resolution must not be negative, got " + std::to_string(job.width) + "x" +
+                                    std::to_string(job.height));
     if (!fs::is_directory(job.fitdir))
         throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
     // The frames' key hashes the fit's files as read around the session's loading of them: a fit

@@ -60,6 +60,10 @@ FrameLatents EditSession::frame(int i, int spp, uint64_t seed, int width, int he
     if (i < 0 || i >= m_edits.frames)
         throw std::invalid_argument("frame " + std::to_string(i) +
                                     " is not within the sequence's 0:" + std::to_string(m_edits.frames - 1));
+    if (spp < 1) throw std::invalid_argument("frame spp must be > 0, got " + std::to_string(spp));
+    if (width < 0 || height < 0)
+        throw std::invalid_argument("frame resolution must not be negative, got " + std::to_string(width) + "x" +
+                                    std::to_string(height));
     const std::lock_guard<std::mutex> one_frame_at_a_time(m_frame_mutex);
     apply_edits(m_edits, time(i), m_original, m_camera, *m_fit.scene);
     m_unseen.show(m_fit.model->terms(), m_fit.tone, m_fit.scene->shapes.size(), m_overridden || !unedited(i));

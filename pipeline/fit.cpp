@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <set>
+#include <optional>
 #include <sstream>
 
 namespace lpt::pipeline {
@@ -199,6 +200,10 @@ void validate(const FitJob& job) {
         if (!(value >= 0.f) || !std::isfinite(value))
             throw std::invalid_argument(std::string(flag) + " must be a finite number >= 0, got " +
                                         std::to_string(value));
+    int w = 0, h = 0;  // checked here, before run_fit touches an existing folder's checkpoint
+    if (job.target.empty())
+        parse_resolution(job.encode ? job.encode_res : job.synthetic_res, w, h,
+                         job.encode ? "--encode-res" : "--synthetic-res");
     if (job.refiner) validate(job.refine);
 }
 
@@ -210,14 +215,19 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     FitOptions o = job.options;
     o.checkpoint_dir = (fs::path(job.out) / "checkpoint").string();
 
+    // Inputs that can be refused are read before the folder is touched: without --resume a fit
+    // starts its checkpoint again, and a typo must not cost an earlier fit's.
+    std::unique_ptr<Vae> vae;
+    if (job.encode) vae = open_vae(job.vae);
+    std::optional<Target> given;
+    if (!job.target.empty()) given = load_target_exr(job.target);
+
     const OutputLock lock(job.out);  // before anything is written there
     const bool resume = prepare_checkpoint(o.checkpoint_dir, stage1_settings(job), job.resume, job.restart_if_changed);
     if (!resume) remove_emitter_refiner(job.out);  // it was trained on another stage 1's renders
-    std::unique_ptr<Vae> vae;
-    if (job.encode) vae = open_vae(job.vae);
-    const Target target = !job.target.empty() ? load_target_exr(job.target)
-                          : job.encode        ? encoded_target(job, scene, *vae, report)
-                                              : synthetic_target(job, scene);
+    const Target target = given        ? std::move(*given)
+                          : job.encode ? encoded_target(job, scene, *vae, report)
+                                       : synthetic_target(job, scene);
     write_latent((fs::path(job.out) / "target.exr").string(), target.width, target.height, target.data);
 
     FitSummary summary;

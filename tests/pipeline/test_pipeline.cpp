@@ -159,6 +159,34 @@ TEST(Pipeline, FitOptionsOutOfRangeAreRefusedByName) {
     EXPECT_FALSE(fs::exists(good.out + "/params.json"));
 }
 
+// Without --resume a fit starts its checkpoint again; one whose inputs are then refused (a
+// misspelt resolution, a missing target or VAE) used to have deleted the earlier fit's first.
+TEST(Pipeline, AFitWithBadInputsLeavesTheFoldersCheckpoint) {
+    const pipeline::FitJob good = small_fit(test::temp_dir("pipeline-fit-keep") + "/fit");
+    pipeline::run_fit(good);
+    const std::string state = read_file(good.out + "/checkpoint/state.json");
+    const std::vector<std::pair<std::string, std::function<void(pipeline::FitJob&)>>> cases = {
+        {"--synthetic-res", [](pipeline::FitJob& j) { j.synthetic_res = "8by8"; }},
+        {"--encode-res", [](pipeline::FitJob& j) { j.encode = true, j.encode_res = "256"; }},
+        {"nope.exr", [](pipeline::FitJob& j) { j.target = "/nonexistent/nope.exr"; }},
+        {"/nonexistent/vae", [](pipeline::FitJob& j) { j.encode = true, j.vae.dir = "/nonexistent/vae"; }},
+    };
+    for (const auto& [named, spoil] : cases) {
+        pipeline::FitJob job = good;
+        spoil(job);
+        test::expect_error_naming<std::exception>([&] { pipeline::run_fit(job); }, {named},
+                                                  "a fit with a bad " + named + " was accepted");
+        EXPECT_EQ(read_file(good.out + "/checkpoint/state.json"), state) << named;
+    }
+    pipeline::FitJob again = good;
+    again.resume = true;
+    std::string said;
+    pipeline::Reporter r;
+    r.note = [&](const std::string& line) { said += line + "\n"; };
+    pipeline::run_fit(again, r);
+    EXPECT_NE(said.find("resuming at iteration 30"), std::string::npos) << said;
+}
+
 TEST(Pipeline, ACheckpointFromBeforeASettingExistedResumesAtItsOldValueOnly) {
     // settings.json written before --emitter-response-decay existed has no key for it: such a
     // checkpoint was made with μ = 0, so μ = 0 resumes it and any other μ is refused by name.
@@ -325,6 +353,10 @@ TEST(Pipeline, EditSessionFramesEqualTheRenderedFiles) {
         EXPECT_EQ(f.refined, read_image(stem + "_refined.exr").data) << i;
     }
     EXPECT_THROW(session.frame(8, 2, 5), std::invalid_argument);
+    EXPECT_THROW(session.frame(1, 0, 5), std::invalid_argument);  // was an all-zero latent
+    EXPECT_THROW(session.frame(1, 2, 5, -4, 8), std::invalid_argument);
+    edit.spp = 0;
+    EXPECT_THROW(pipeline::render_edits(edit), std::invalid_argument);  // was eight black frames
 }
 
 // Noise views come from the fit folder: more views change what the refiner sees (iteration
