@@ -42,6 +42,10 @@ struct LatentScene {
 std::shared_ptr<LatentScene> fresh(std::shared_ptr<Scene> scene, const std::string& param, uint64_t seed,
                                    const std::string& terms, const std::string& gate, const std::string& tone,
                                    int width, int height) {
+    if (!scene) throw py::type_error("LatentScene: scene must be a latentpt.Scene, got None");
+    if (width < 0 || height < 0)
+        throw py::value_error("LatentScene: width and height must be >= 0 (0: the scene's), got " +
+                              std::to_string(width) + "x" + std::to_string(height));
     auto ls = std::make_shared<LatentScene>();
     ls->scene = std::move(scene);
     ls->model = std::make_unique<LatentModel>(*ls->scene, parameterisation_from_string(param), seed);

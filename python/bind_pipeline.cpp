@@ -8,6 +8,7 @@
 #include "pipeline/refine.h"
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
+#include <algorithm>
 #include <pybind11/stl.h>
 
 namespace lpt::python {
@@ -209,7 +210,15 @@ struct PyVae {
 py::array_t<float> encode(const PyVae& v, const py::array_t<float, py::array::c_style | py::array::forcecast>& rgb) {
     if (rgb.ndim() != 3 || rgb.shape(2) != 3) throw py::value_error("encode: expected an (height, width, 3) array");
     const int h = int(rgb.shape(0)), w = int(rgb.shape(1)), f = v.vae->convention().downsample;
-    std::vector<float> in(rgb.data(), rgb.data() + rgb.size()), out;
+    if (h < f || w < f)  // torch's own error here is a C++ stack trace
+        throw py::value_error("encode: the image must be at least " + std::to_string(f) + "x" + std::to_string(f) +
+                              ", got " + std::to_string(w) + "x" + std::to_string(h));
+    std::vector<float> in = from_numpy(rgb, {h, w, 3}, "encode: rgb"), out;
+    // Display values: 0-255 bytes read as floats gave latents of +-700 without a word.
+    const auto [lo, hi] = std::minmax_element(in.begin(), in.end());
+    if (*lo < -1e-3f || *hi > 1.f + 1e-3f)
+        throw py::value_error("encode: rgb must be display values in [0, 1], got [" + std::to_string(*lo) + ", " +
+                              std::to_string(*hi) + "] (8-bit images: divide by 255)");
     {
         py::gil_scoped_release unlocked;
         out = v.vae->encode(in, w, h);
@@ -222,7 +231,8 @@ py::array_t<float> decode(const PyVae& v, const py::array_t<float, py::array::c_
         throw py::value_error("decode: expected a (height, width, " + std::to_string(v.vae->convention().channels) +
                               ") array");
     const int h = int(latent.shape(0)), w = int(latent.shape(1)), f = v.vae->convention().downsample;
-    std::vector<float> in(latent.data(), latent.data() + latent.size()), out;
+    if (h < 1 || w < 1) throw py::value_error("decode: the latent is empty");
+    std::vector<float> in = from_numpy(latent, {h, w, v.vae->convention().channels}, "decode: latent"), out;
     {
         py::gil_scoped_release unlocked;
         out = v.vae->decode(in, w, h);

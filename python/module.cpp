@@ -29,9 +29,10 @@ std::vector<float> from_numpy(const py::array_t<float, py::array::c_style | py::
         throw py::value_error(what + ": expected an array of shape " + shape_text(shape) + ", got " + shape_text(got));
     std::vector<float> v(a.data(), a.data() + a.size());
     size_t bad = 0;
-    if (!check_finite(v.data(), v.size(), &bad))
-        throw py::value_error(what + ": value " + std::to_string(bad) + " is not finite");
-    return v;
+    if (check_finite(v.data(), v.size(), &bad)) return v;
+    std::vector<py::ssize_t> at(shape.size());  // the flat index as the caller's (i, j, k)
+    for (size_t d = shape.size(); d-- > 0; bad /= size_t(shape[d])) at[d] = py::ssize_t(bad % size_t(shape[d]));
+    throw py::value_error(what + ": the value at " + shape_text(at) + " is not finite (as a float32)");
 }
 
 }  // namespace lpt::python

@@ -43,6 +43,10 @@ def render_latent(model, raw, width=0, height=0, spp=16, seed=0):
     tensor laid out as model.raw), on raw's device and in its dtype (computed in float32 on the
     CPU); 0 = the model's latent resolution. Differentiable in `raw`, once: the gradient itself
     is not differentiable."""
+    if not isinstance(raw, torch.Tensor) or not raw.is_floating_point():
+        # an integer tensor would come back as a latent truncated to integers, with no gradient
+        raise TypeError("render_latent: raw must be a floating-point torch.Tensor, got "
+                        + (str(raw.dtype) if isinstance(raw, torch.Tensor) else type(raw).__name__))
     return _LatentRender.apply(raw, model, width, height, spp, seed)
 
 

@@ -79,7 +79,7 @@ class LatentTest(unittest.TestCase):
             m.raw = raw.reshape(-1, 1)
         bad = raw.copy()
         bad[3] = np.nan
-        with self.assertRaisesRegex(ValueError, "raw: value 3 is not finite"):
+        with self.assertRaisesRegex(ValueError, r"raw: the value at \(3,\) is not finite"):
             m.raw = bad
         v = np.linspace(0.1, 0.5, 16, dtype=np.float32)
         v[-1] = np.nan  # refused at the last channel: the channels before it stay as they were
@@ -90,6 +90,22 @@ class LatentTest(unittest.TestCase):
                      lambda: m.scene.aovs(spp=0), lambda: m.scene.render(spp=-2)):
             with self.assertRaisesRegex(ValueError, "spp must be > 0"):
                 call()
+
+    def test_bad_model_and_render_arguments_are_refused_by_name(self):
+        scene = self.model.scene
+        with self.assertRaisesRegex(TypeError, "got None"):  # was a segmentation fault
+            latentpt.LatentScene(None)
+        with self.assertRaisesRegex(ValueError, "terms take letters from e, a, c; got 'xyz'"):
+            latentpt.LatentScene(scene, terms="xyz")  # rendered zeros
+        with self.assertRaisesRegex(ValueError, "gate is shadowed or visible, got 'visble'"):
+            latentpt.LatentScene(scene, gate="visble")  # meant shadowed
+        with self.assertRaisesRegex(ValueError, "width and height"):
+            latentpt.LatentScene(scene, width=-4)
+        for call in (lambda: scene.render(spp=1, width=-4), lambda: scene.aovs(height=-1)):
+            with self.assertRaisesRegex(ValueError, "width and height must be >= 0"):
+                call()  # the scene's size, without a word
+        with self.assertRaisesRegex(ValueError, "max_depth must be >= -1"):
+            scene.render(spp=1, max_depth=-5)
 
     def test_renders_and_parameter_changes_from_several_threads_do_not_race(self):
         """A render in one thread and raw writes in another: every render is of one raw vector."""
@@ -203,6 +219,32 @@ class LatentTest(unittest.TestCase):
         (w.double() * latent64).sum().backward()
         self.assertEqual(raw64.grad.dtype, torch.float64)
         np.testing.assert_allclose(raw64.grad.numpy(), expected, rtol=1e-5, atol=1e-8)
+        with self.assertRaisesRegex(TypeError, "floating-point torch.Tensor, got torch.int64"):
+            lt.render_latent(m, raw.detach().long(), spp=1)  # was a latent truncated to integers
+
+
+class VaeTest(unittest.TestCase):
+    def test_arrays_the_vae_cannot_read_are_refused_by_name(self):
+        shared = os.environ.get("LATENTPT_SHARED", os.path.join(SRC, "..", "shared"))
+        if not os.path.exists(os.path.join(shared, "models", "taesd3", "taesd3_encoder.safetensors")):
+            self.skipTest("no TAESD3 weights in ../shared")
+        vae = latentpt.Vae(os.path.join(shared, "models", "taesd3"))
+        grey = np.full((16, 16, 3), 0.5, np.float32)
+        self.assertEqual(vae.encode(grey).shape, (2, 2, 16))
+        bad = grey.copy()
+        bad[1, 2, 0] = np.nan  # passed through as NaN latents
+        with self.assertRaisesRegex(ValueError, r"encode: rgb: the value at \(1, 2, 0\) is not finite"):
+            vae.encode(bad)
+        with self.assertRaisesRegex(ValueError, r"display values in \[0, 1\].*divide by 255"):
+            vae.encode(np.full((16, 16, 3), 200, np.uint8))  # latents of +-700
+        with self.assertRaisesRegex(ValueError, "at least 8x8, got 0x0"):
+            vae.encode(np.zeros((0, 0, 3), np.float32))  # torch's C++ stack trace
+        latent = vae.encode(grey)
+        latent[0, 1, 3] = np.inf
+        with self.assertRaisesRegex(ValueError, r"decode: latent: the value at \(0, 1, 3\) is not finite"):
+            vae.decode(latent)
+        with self.assertRaisesRegex(ValueError, "decode: the latent is empty"):
+            vae.decode(np.zeros((0, 2, 16), np.float32))
 
 
 class GuidanceTest(unittest.TestCase):
