@@ -224,7 +224,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
 
     const OutputLock lock(job.out);  // before anything is written there
     const bool resume = prepare_checkpoint(o.checkpoint_dir, stage1_settings(job), job.resume, job.restart_if_changed);
-    if (!resume) remove_emitter_refiner(job.out);  // it was trained on another stage 1's renders
+    if (!resume) remove_refiners(job.out);  // they were trained on another stage 1's renders
     const Target target = given        ? std::move(*given)
                           : job.encode ? encoded_target(job, scene, *vae, report)
                                        : synthetic_target(job, scene);
@@ -241,7 +241,7 @@ FitSummary run_fit(const FitJob& job, const Reporter& report) {
     // (started again and killed before its refiners, or given more iterations) makes them stale,
     // their checkpoints too.
     const bool stage1_as_before = resume && summary.state.history.size() == steps_before;
-    if (!stage1_as_before) remove_emitter_refiner(job.out);
+    if (!stage1_as_before) remove_refiners(job.out);
     report.say(stage1_summary(summary.state, o.patience));
     save_checkpoint(o.checkpoint_dir, model, summary.state);
     summary.latent_width = target.width;

@@ -275,6 +275,17 @@ RefinerFiles refiner_files(const RefineJob& job) {
     return {dir / kEmitterRefinerFile, dir / kEmitterRefinerCheckpoint, dir / kEmitterRefinerLoss};
 }
 
+}  // namespace
+
+void remove_refiners(const std::string& dir) {
+    remove_emitter_refiner(dir);
+    for (const char* name : {"refiner.pt", "refiner_checkpoint.pt", "refiner_checkpoint.json", "refiner_loss.csv",
+                             "latent_refined.exr", "decoded_refined.png", "metrics.json"})
+        fs::remove(fs::path(dir) / name);
+}
+
+namespace {
+
 /// metrics.json as it is, or an empty object when there is none. One that is not a JSON object
 /// is an error when `strict` (an emitter refiner adds its record to the main refiner's cells,
 /// which would be lost); the main refiner writes the file anew and reads it as empty.

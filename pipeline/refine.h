@@ -63,6 +63,11 @@ struct RefineSummary {
 /// its range: the command line checks them as it parses, library and Python callers here.
 void validate(const RefineJob& job);
 
+/// Removes both refiners' files from fit folder `dir`, with what they wrote (latent_refined.exr,
+/// decoded_refined.png, metrics.json): a new stage 1 makes them stale, and an edit would apply
+/// them to the new fit's renders.
+void remove_refiners(const std::string& dir);
+
 /// Throws Cancelled when the reporter cancels (refiner_checkpoint.pt keeps the last checkpoint).
 RefineSummary run_refine(const RefineJob& job, const Reporter& report = {});
 

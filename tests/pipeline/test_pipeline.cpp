@@ -136,6 +136,24 @@ TEST(Pipeline, AStage1StartedAgainTrainsItsRefinerAgainWhenResumed) {
     EXPECT_EQ(read_file(job.out + "/params.json"), read_file(fresh.out + "/params.json"));
 }
 
+// A fit without its refiner into the folder of one with: the old refiner.pt stayed, and edits
+// applied it to the new fit's renders.
+TEST(Pipeline, AStage1StartedAgainRemovesTheOldRefiner) {
+    pipeline::FitJob job = small_fit(test::temp_dir("pipeline-refit") + "/fit");
+    job.refiner = true;
+    job.refine.net.expansion = 1;
+    job.refine.train.iterations = 2;
+    pipeline::run_fit(job);
+    const char* stage2[] = {"refiner.pt", "refiner_checkpoint.pt", "refiner_loss.csv", "latent_refined.exr",
+                            "metrics.json"};
+    for (const char* name : stage2) ASSERT_TRUE(fs::exists(job.out + "/" + name)) << name;
+    job.refiner = false;
+    job.options.seed = 9;
+    pipeline::run_fit(job);
+    for (const char* name : stage2) EXPECT_FALSE(fs::exists(job.out + "/" + name)) << name << " outlived its fit";
+    EXPECT_TRUE(fs::exists(job.out + "/params.json"));
+}
+
 // The fit's own checks, not only the CLI's: a caller without it (latentpt.fit in Python) gets an
 // error naming the option rather than a fit at zero gradient or a division by a zero period.
 TEST(Pipeline, FitOptionsOutOfRangeAreRefusedByName) {
