@@ -328,6 +328,13 @@ int inference_window(const RefineJob& job, const RefinerInput& in) {
 void write_results(const RefineJob& job, const RefinerFiles& files, const Refiner& refiner, const RefinerInput& in,
                    const Image& target, const Judges& judges, RefineSummary& s) {
     const fs::path dir(job.fitdir);
+    std::vector<float> refined;
+    if (!job.emitters) {
+        refined = refiner.refine(in);
+        if (!check_finite(refined.data(), refined.size()))
+            throw std::runtime_error(
+                job.fitdir + ": the trained refiner's output of the training view is not finite; nothing written");
+    }
     refiner.save(files.weights.string());
     write_text_atomic(files.loss.string(), refiner_csv(s.result));
     const nlohmann::json before = existing_metrics(dir, job.emitters);
@@ -337,7 +344,6 @@ void write_results(const RefineJob& job, const RefinerFiles& files, const Refine
         s.metrics = before;
         s.metrics["emitter_refiner"] = training_record(job, refiner, s.result);
     } else {
-        const std::vector<float> refined = refiner.refine(in);
         write_latent((dir / "latent_refined.exr").string(), in.width, in.height, refined);
         s.metrics = judge(dir, in, refined, target, judges);
         s.metrics["refiner"] = training_record(job, refiner, s.result);
@@ -362,7 +368,8 @@ void validate(const RefineJob& job) {
     const RefinerTrainOptions& t = job.train;
     const RefinerConfig& n = job.net;
     require(t.iterations > 0, "iterations", "> 0", t.iterations);
-    require(n.expansion > 0, "expansion", "> 0", n.expansion);
+    // 64 is 4x the default's width; 10^5 ended in a 26-line torch allocation trace
+    require(n.expansion > 0 && n.expansion <= 64, "expansion", "in [1, 64]", n.expansion);
     require(t.crop >= 0, "crop", ">= 0", t.crop);
     require(job.window_stride > 0, "window-stride", "> 0", job.window_stride);
     require(t.crop == 0 || job.window_stride <= t.crop, "window-stride", "at most --crop (every pixel in a window)",
@@ -370,12 +377,13 @@ void validate(const RefineJob& job) {
     require(t.lpips_crop >= 0, "lpips-crop", ">= 0", t.lpips_crop);
     require(t.lr > 0 && std::isfinite(t.lr), "lr", "> 0", t.lr);
     require(t.patience >= 0, "patience", ">= 0", t.patience);
-    require(t.w_mse >= 0, "w-mse", ">= 0", t.w_mse);
-    require(t.w_ssim >= 0, "w-ssim", ">= 0", t.w_ssim);
-    require(t.w_lpips >= 0, "w-lpips", ">= 0", t.w_lpips);
+    require(t.w_mse >= 0 && std::isfinite(t.w_mse), "w-mse", ">= 0", t.w_mse);
+    require(t.w_ssim >= 0 && std::isfinite(t.w_ssim), "w-ssim", ">= 0", t.w_ssim);
+    require(t.w_lpips >= 0 && std::isfinite(t.w_lpips), "w-lpips", ">= 0", t.w_lpips);
+    require(t.w_mse + t.w_ssim + t.w_lpips > 0, "w-mse", "> 0 when --w-ssim and --w-lpips are 0 (no loss)", t.w_mse);
     require(n.squash > 0 && std::isfinite(n.squash), "squash", "> 0", n.squash);
     require(n.dropout >= 0 && n.dropout <= 0.99f, "dropout", "in [0, 0.99]", n.dropout);
-    require(job.noise_views > 0, "noise-views", "> 0", job.noise_views);
+    require(job.noise_views > 0 && job.noise_views <= 64, "noise-views", "in [1, 64]", job.noise_views);
     require(t.input_noise >= 0 && std::isfinite(t.input_noise), "input-noise", ">= 0", t.input_noise);
     // the terms carry the latent's render noise too; read clean, the body could still key on it
     require(t.input_noise == 0 || !n.terms, "input-noise", "0 with --inputs terms (the terms are read without noise)",
@@ -447,6 +455,16 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
                    "\"Augmentation\")");
     s.result = refiner->train(examples, judges.vae.get(), judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");
+    // Refused steps keep the weights: a last one refused for its loss means the weights to be
+    // saved give a non-finite loss (--lr 1e30: one step to huge weights, every later one
+    // refused); all refused, they were never trained. Either was written with exit 0.
+    const std::vector<RefinerRecord>& h = s.result.history;
+    const bool none_taken = std::all_of(h.begin(), h.end(), [](const RefinerRecord& r) { return r.refused; });
+    if (!h.empty() && (none_taken || !std::isfinite(h.back().loss)))
+        throw std::runtime_error(job.fitdir + ": the refiner's " +
+                                 (none_taken ? "every step was refused" : "loss at its last step is not finite") +
+                                 " (the loss or a gradient not finite); nothing written: check --lr and the loss "
+                                 "weights");
     char best[96];
     std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,
                   s.result.best_iteration);

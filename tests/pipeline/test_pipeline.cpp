@@ -12,7 +12,9 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <map>
 
 using namespace lpt;
@@ -436,4 +438,31 @@ TEST(Pipeline, RefinerResumeRefusesOrRestartsACheckpointOfOtherSettings) {
     const pipeline::RefineSummary again = pipeline::run_refine(r);
     EXPECT_EQ(again.result.history.size(), 8u);
     EXPECT_EQ(again.result.history.back().loss, scratch.result.history.back().loss);
+}
+
+// A refine that could train nothing wrote an untrained refiner.pt with null metrics and exit 0:
+// a NaN pixel in the fit folder, a learning rate that overflows the loss, no loss at all.
+TEST(Pipeline, ARefinerThatCannotTrainIsAnError) {
+    const pipeline::RefineJob good = small_refine(test::temp_dir("pipeline-refine-untrainable"), 3);
+    const std::vector<std::pair<std::string, std::function<void(pipeline::RefineJob&)>>> options = {
+        {"--w-mse", [](pipeline::RefineJob& r) { r.train.w_mse = std::numeric_limits<float>::infinity(); }},
+        {"--w-mse", [](pipeline::RefineJob& r) { r.train.w_mse = 0.f; }},
+        {"--expansion", [](pipeline::RefineJob& r) { r.net.expansion = 100000; }},
+        {"--noise-views", [](pipeline::RefineJob& r) { r.noise_views = 1000000; }},
+    };
+    for (const auto& [named, spoil] : options) {
+        pipeline::RefineJob r = good;
+        spoil(r);
+        test::expect_error_naming<std::invalid_argument>([&] { pipeline::run_refine(r); }, {named});
+    }
+    pipeline::RefineJob huge_lr = good;
+    huge_lr.train.lr = 1e30f;
+    test::expect_error_naming([&] { pipeline::run_refine(huge_lr); }, {"not finite"});
+    EXPECT_FALSE(fs::exists(good.fitdir + "/refiner.pt"));
+
+    Image target = read_image(good.fitdir + "/target.exr");
+    target.data[5] = std::nanf("");
+    write_exr(good.fitdir + "/target.exr", target);
+    test::expect_error_naming([&] { pipeline::run_refine(good); }, {"target.exr", "not finite"});
+    EXPECT_FALSE(fs::exists(good.fitdir + "/refiner.pt"));
 }
