@@ -4,6 +4,7 @@
 #pragma once
 #include "apps/commands.h"
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,33 @@ inline CLI::Validator bounded_below(bool strict) {
 }
 inline CLI::Validator positive() { return bounded_below(true); }
 inline CLI::Validator non_negative() { return bounded_below(false); }
+
+/// A finite number: --exposure nan wrote an all-black preview.
+inline CLI::Validator finite() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                size_t used = 0;
+                const double v = std::stod(text, &used);
+                if (used == text.size() && std::isfinite(v)) return "";
+            } catch (const std::exception&) {}
+            return "expected a finite number, got '" + text + "'";
+        },
+        "finite");
+}
+
+/// A seed: digits only, within 64 bits (-1, 2^64 and 1e23 all became 2^64 - 1).
+inline CLI::Validator seed_value() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+            try {
+                if (digits) return std::stoull(text), "";
+            } catch (const std::exception&) {}
+            return "expected an integer in [0, 2^64 - 1], got '" + text + "'";
+        },
+        "0 ... 2^64-1");
+}
 
 /// The autoencoder: native TAESD3 weights, or any VAE exported to TorchScript (tools/export_vae.py).
 inline void add_vae_options(CLI::App* sc, VaeSource& vs) {

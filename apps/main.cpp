@@ -8,6 +8,7 @@
 #include "integrators/path.h"
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -56,6 +57,7 @@ struct Cli {
                          "with --reference: the references' seed (each edited frame's is made from it and the frame's "
                          "index); another traces independent references (cached apart), e.g. to measure their noise")
             ->capture_default_str()
+            ->check(seed_value())
             ->needs(reference);
         render
             ->add_option("--reference-cache", r.reference_cache,
@@ -79,16 +81,24 @@ struct Cli {
             ->check(non_negative());
         render->add_option("--res", r.res, "resolution WxH (default: the scene's camera)");
         render->add_option("--seed", r.seed, "random seed: same seed, same image, at any thread count")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(seed_value());
         render
             ->add_option("--max-depth", r.max_depth, "longest path in segments, -1 = unbounded (default: the scene's)")
-            ->check(CLI::Range(-1, 1 << 20));
+            ->check(CLI::Range(-1, 1 << 20))
+            ->excludes(edit);  // the RGB renderer's options: an edit renders the fit's latents
         render->add_option("--strategy", r.strategy, "light estimator: mis (NEE + BSDF sampling), nee, bsdf")
             ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
-            ->capture_default_str();
-        render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr");
-        render->add_option("--aov-res", r.aov_res, "AOV resolution WxH (default: the image's; latents: image/8)");
-        render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")->capture_default_str();
+            ->capture_default_str()
+            ->excludes(edit);
+        auto* aov =
+            render->add_flag("--aov", r.aov, "also write <out>.normal.exr, <out>.distance.exr, <out>.albedo.exr")
+                ->excludes(edit);
+        render->add_option("--aov-res", r.aov_res, "with --aov: AOV resolution WxH (default: the image's)")->needs(aov);
+        render->add_option("--exposure", r.exposure, "PNG preview exposure in stops")
+            ->capture_default_str()
+            ->check(finite())
+            ->excludes(edit);
         render->add_option(
             "-D,--define", defines,
             "override a scene value: a key path of a .json scene (-D integrator.max_depth=4), a "
@@ -106,7 +116,7 @@ struct Cli {
             ->add_option("--sphere-triangles", b.sphere_triangles,
                          "triangles of the sphere added for the heavy-scene run")
             ->capture_default_str()
-            ->check(positive());
+            ->check(CLI::Range(1, 20000000));  // ~2 GB of mesh and BVH at the top
         bench->add_option("--json", b.out_json, "also write the results as JSON");
         auto* fit_flag =
             bench->add_flag("--fit", b.fit, "time fit iterations (forward and adjoint) at latent resolution instead");
@@ -198,7 +208,8 @@ struct Cli {
             ->capture_default_str()
             ->check(positive());
         fit->add_option("--seed", f.job.options.seed, "seed of the initial parameters and of every iteration's paths")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(seed_value());
         fit->add_option("--lr", f.job.options.lr, "Adam learning rate (cosine annealing with warm restarts)")
             ->capture_default_str()
             ->check(positive());
@@ -268,7 +279,8 @@ struct Cli {
         fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")
             ->capture_default_str();
         fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(seed_value());
         add_fit_model();
         add_fit_optimisation();
     }
@@ -281,7 +293,8 @@ struct Cli {
             ->check(CLI::ExistingDirectory);
         add_refine_options(refine, rf.job, "");
         refine->add_option("--seed", rf.job.train.seed, "seed of the initial weights, crops and dropout")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(seed_value());
         auto* resume = refine->add_flag(
             "--resume", rf.job.resume,
             "continue from <fitdir>/refiner_checkpoint.pt; one trained with other settings is an error");
@@ -351,7 +364,8 @@ struct Cli {
                    "verdict: channel means within this relative difference", non_negative());
         add_number(compare, "--ratio-range", cmp.ratio_range, "ratio map colour saturates at 1 +- this", positive());
         compare->add_option("--exposure", cmp.exposure, "exposure of the side-by-side previews in stops")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(finite());
         compare->add_option("-o,--out-dir", cmp.out_dir,
                             "write comparison.txt/.json, ratio_map.png, side_by_side.png here");
         compare->add_flag("--strict", cmp.strict, "exit with code 3 when the verdict is FAIL");
@@ -372,6 +386,7 @@ struct Cli {
                    : b.startup            ? run_bench_startup(b)
                    : b.fit                ? run_bench_fit(b)
                                           : run_bench(b);
+        if (*encode || *decode || *viz) refuse_output_over_input(v);
         if (*encode) return torch_commands().encode(v);
         if (*decode) return torch_commands().decode(v);
         if (*viz) return run_viz(v);
@@ -387,6 +402,13 @@ struct Cli {
             return torch_commands().fit(f);
         }
         return 0;
+    }
+
+    /// decode l.exr --out l.exr replaced the latent by its picture.
+    static void refuse_output_over_input(const VaeArgs& v) {
+        std::error_code ec;
+        if (std::filesystem::equivalent(v.input, v.out, ec))
+            throw std::invalid_argument(v.out + ": --out is the input file; name another");
     }
 
     /// -D key=value pairs.
@@ -409,7 +431,8 @@ int main(int argc, char** argv) {
     lpt::app::Cli cli;
     CLI::App app{"latentpt: a differentiable path tracer that renders into the latent space of an image autoencoder"};
     app.require_subcommand(1);
-    app.add_option("--threads", cli.threads, "worker threads (default: all cores)")->check(lpt::app::positive());
+    // 10^7 threads took 1.3 GB before the first pixel; 4096 is past any machine's cores
+    app.add_option("--threads", cli.threads, "worker threads (default: all cores)")->check(CLI::Range(1, 4096));
     app.add_option("--sampler", cli.sampler,
                    "random numbers of every render: sobol (Owen-scrambled, low discrepancy) or independent "
                    "(default: the scene's; a fit keeps the one it was given; docs/sampling.md)")

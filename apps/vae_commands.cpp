@@ -15,8 +15,14 @@ namespace fs = std::filesystem;
 namespace {
 
 void require_rgb(const Image& img, const std::string& path) {
-    if (img.channels < 3)
-        throw std::runtime_error(path + ": needs 3 channels (RGB), has " + std::to_string(img.channels));
+    if (img.channels != 3 && img.channels != 4)  // a 16-channel latent encoded its first three
+        throw std::runtime_error(path + ": needs 3 channels (RGB) or 4 (RGBA), has " + std::to_string(img.channels));
+}
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
 }
 
 }  // namespace
@@ -48,7 +54,10 @@ int run_decode(const VaeArgs& a) {
     // Decoded values are display-referred (about [0, 1]): EXR keeps them unclamped, PNG as they are.
     const int f = vae->convention().downsample;
     Image out{lat.width * f, lat.height * f, 3, rgb, {"R", "G", "B"}, true};
-    if (fs::path(a.out).extension() == ".exr") write_exr(a.out, out);
+    const std::string ext = lower_extension(a.out);
+    if (ext != ".exr" && ext != ".png")  // "d.jpg" got PNG bytes, "d.EXR" too
+        throw std::invalid_argument(a.out + ": --out must end in .png or .exr");
+    if (ext == ".exr") write_exr(a.out, out);
     else write_png_display(a.out, out);
     if (!a.quiet) std::cerr << "wrote " << a.out << " (" << out.width << "x" << out.height << ")\n";
     return 0;

@@ -37,16 +37,22 @@ std::string temp_path_for(const std::string& path) {
 /// a failure removes the temporary and names `path` and `what` it is.
 template <typename Write>
 void write_atomically(const std::string& path, Write write, const char* what = "image") {
-    if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
     const std::string tmp = temp_path_for(path);
     try {
+        if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
         write(tmp);
+        fs::rename(tmp, path);  // fails onto a folder of that name: the temporary must not stay
     } catch (const std::exception& e) {
         std::error_code ec;
         fs::remove(tmp, ec);
         throw std::runtime_error(path + ": cannot write " + what + ": " + e.what());
     }
-    fs::rename(tmp, path);
+}
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
 }
 
 /// The names OpenImageIO gave channels when it wrote our EXRs (kept, so files stay the same):
@@ -89,9 +95,7 @@ float linear_to_srgb(float v) {
 }
 
 void write_exr(const std::string& path, const Image& img) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext != ".exr")
+    if (lower_extension(path) != ".exr")
         throw std::invalid_argument(path + ": an OpenEXR file is written here; its name must end in .exr");
     const std::vector<std::string> names = exr_channel_names(img);
     if (int(names.size()) != img.channels || img.data.size() != size_t(img.width) * img.height * img.channels)
@@ -119,6 +123,9 @@ void write_exr(const std::string& path, const Image& img) {
 namespace {
 template <typename Encode>
 void write_png8(const std::string& path, const Image& img, Encode encode) {
+    // Readers tell a picture's kind by its name: PNG bytes in "v.exr" would read as linear.
+    if (lower_extension(path) != ".png")
+        throw std::invalid_argument(path + ": a PNG file is written here; its name must end in .png");
     std::vector<uint8_t> px(size_t(img.width) * img.height * 3);
     for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
         for (int c = 0; c < 3; ++c) {

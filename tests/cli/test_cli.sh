@@ -17,6 +17,17 @@ scene="$src/scenes/cornell-box/scene.json"
 
 "$bin" render "$scene" --spp 2 --res 24x16 --aov --aov-res 6x4 -q --out "$out/r.exr"
 check test -s "$out/r.exr"; check test -s "$out/r.png"; check test -s "$out/r.normal.exr"
+# Numbers that became others without a word: seed -1 was 2^64 - 1, exposure nan a black preview,
+# 10^7 threads gigabytes; the RGB renderer's options did nothing with --edit.
+expect_error "--seed: expected an integer" "$bin" render "$scene" --seed -1 --res 8x8 --spp 1 -q --out "$out/s.exr"
+expect_error "--exposure: expected a finite number" "$bin" render "$scene" --exposure nan --res 8x8 --spp 1 -q --out "$out/s.exr"
+expect_error "--threads" "$bin" --threads 10000000 render "$scene" --res 8x8 --spp 1 -q --out "$out/s.exr"
+expect_error "excludes --aov" "$bin" render "$scene" --edit "$src/scenes/cornell-box/edits-demo.json" --aov -q --out "$out/s"
+expect_error "--aov-res requires --aov" "$bin" render "$scene" --aov-res 4x4 --res 8x8 --spp 1 -q --out "$out/s.exr"
+# A rename onto a folder of the output's name failed and left the temporary beside it.
+mkdir -p "$out/folder.exr"
+expect_error "folder.exr: cannot write image" "$bin" render "$scene" --res 8x8 --spp 1 -q --out "$out/folder.exr"
+check test -z "$(ls -A "$out" | grep '^\.folder\.tmp')"
 
 # -D overrides a scene value as the dedicated flag does: the same pixels (render -D crashed from
 # 2026-11-25 to 11-26: its option was bound to a local that was gone by parse time).
@@ -101,7 +112,7 @@ expect_error "WxH" "$bin" render "$scene" --res 12 -q --out "$out/x.exr"
 expect_error "must be >= 0, got -1" "$bin" render "$scene" --spp -1 -q --out "$out/x.exr"
 expect_error "patience" "$bin" fit "$scene" --synthetic-res 8x8 --patience -1 -q --out "$out/x_fit"
 expect_error "checkpoint-every" "$bin" fit "$scene" --synthetic-res 8x8 --checkpoint-every -1 -q --out "$out/x_fit"
-expect_error "must be > 0, got 0" "$bin" --threads 0 render "$scene" -q --out "$out/x.exr"
+expect_error "--threads: Value 0 not in range 1 to 4096" "$bin" --threads 0 render "$scene" -q --out "$out/x.exr"
 expect_error "must be > 0" "$bin" fit "$scene" --iterations 0 -q --out "$out/bad"
 expect_error "GiB" "$bin" render "$scene" --res 100000x100000 -q --out "$out/x.exr"
 expect_error "--terms" "$bin" fit "$scene" --terms xyz -q --out "$out/bad"
@@ -115,6 +126,13 @@ if [ -d "$shared/models/taesd3" ]; then
     "$bin" encode "$out/e.png" -q --out "$out/lat.exr"; check test -s "$out/lat.exr"
     check test "$("$bin" decode "$out/lat.exr" -q --out "$out/dec.png" && oiiotool --info "$out/dec.png" | grep -c '32 x   16')" -eq 1
     "$bin" viz "$out/lat.exr" -q --out "$out/viz.png"; check test -s "$out/viz.png"
+    # Readers tell a picture's kind by its name: PNG bytes in "v.exr" read as linear; a decode
+    # over its input replaced the latent; a latent's first three channels were encoded as RGB.
+    expect_error "must end in .png" "$bin" viz "$out/lat.exr" -q --out "$out/viz.exr"
+    expect_error "must end in .png or .exr" "$bin" decode "$out/lat.exr" -q --out "$out/dec.jpg"
+    expect_error "is the input file" "$bin" decode "$out/lat.exr" -q --out "$out/lat.exr"
+    expect_error "needs 3 channels (RGB) or 4" "$bin" encode "$out/lat.exr" -q --out "$out/lat2.exr"
+    "$bin" decode "$out/lat.exr" -q --out "$out/dec_upper.EXR"; check oiiotool --info "$out/dec_upper.EXR"
     # metrics --pairs: one JSON line per pair (empty lines skipped), each what a call of its own
     # prints; an image against itself scores 0, LPIPS too (24² is above LPIPS's smallest size).
     "$bin" render "$scene" --spp 1 --res 24x24 -q --out "$out/m1.exr"
