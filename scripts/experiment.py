@@ -38,6 +38,7 @@ summary.md.
 import argparse
 import fcntl
 import json
+import math
 import os
 import signal
 import subprocess
@@ -128,6 +129,34 @@ def run_workflow(cmd, lock, progress=None):
     return returncode, (received[0] if received else None)
 
 
+def check_arguments(ap, a):
+    """Refuses what would plan nothing or something else than asked: --frames -3 planned no edit
+    jobs and the summary rule then emptied an earlier run's results; 0 meant the default."""
+    if a.quick and a.paper:
+        ap.error("--quick and --paper are two presets; give one (--paper with other flags overrides its values)")
+    for flag in ("image_res", "frames", "ref_spp", "fit_iterations", "refiner_iterations", "frame_step", "spp",
+                 "chunk", "cores", "jobs"):
+        value = getattr(a, flag)
+        if value is not None and value < 1:
+            ap.error(f"--{flag.replace('_', '-')} must be >= 1, got {value}")
+    if a.image_res is not None and a.image_res % 8:
+        ap.error(f"--image-res must be a multiple of 8 (latents are 1/8 of it), got {a.image_res}")
+    for flag in ("emission_decay", "emitter_response_decay"):
+        value = getattr(a, flag)
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            ap.error(f"--{flag.replace('_', '-')} must be a finite number >= 0, got {value}")
+    if a.refiner_dropout is not None and not 0 <= a.refiner_dropout <= 0.99:
+        ap.error(f"--refiner-dropout must be in [0, 0.99], got {a.refiner_dropout}")
+    if os.path.exists(a.out) and not os.path.isdir(a.out):
+        ap.error(f"--out {a.out} is a file; name a folder (new or an earlier run's)")
+
+
+def is_dry_run(snakemake_args):
+    """Snakemake's --dry-run, -n, or -n among combined short flags (-np)."""
+    return any(x in ("--dry-run", "--dryrun") or (x.startswith("-") and not x.startswith("--") and "n" in x[1:])
+               for x in snakemake_args)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="one scene, small and short; checks the ablation ordering (CI)")
@@ -177,6 +206,7 @@ def main():
                          "scratch, give a new --out")
     ap.add_argument("snakemake_args", nargs="*", help="after --: passed to snakemake (e.g. -- --dry-run)")
     a = ap.parse_args()
+    check_arguments(ap, a)
     c = X.settings(quick=a.quick, scenes=a.scenes.split(",") if a.scenes else None, out=a.out, bin=a.bin,
                    shared=a.shared, image_res=a.image_res, frames=a.frames, ref_spp=a.ref_spp,
                    fit_iterations=a.fit_iterations, refiner_iterations=a.refiner_iterations, spp=a.spp, chunk=a.chunk,
@@ -202,13 +232,15 @@ def main():
     except OSError:
         sys.exit(f"experiment: {c['out']} is in use by another experiment run (or by the Snakemake of one whose "
                  "experiment.py was killed; it goes on to the end)")
-    config_path = os.path.join(c["out"], "experiment-config.json")
+    dry_run = is_dry_run(a.snakemake_args)
+    # a dry run plans with its own copy: refiner_study.py and seed_spread.py read the folder's
+    # experiment-config.json as the settings its results were made with
+    config_path = os.path.join(c["out"], "experiment-config" + (".dry-run" if dry_run else "") + ".json")
     X.write_atomic(config_path, json.dumps(c, indent=1))
     started = time.time()
     # Locally one job runs at a time (each takes every core), so the jobs' times add up to the
     # run's; on Slurm they overlap, and the line says job time only.
     cmd = snakemake_command(a, config_path, c["out"])
-    dry_run = "--dry-run" in a.snakemake_args or "-n" in a.snakemake_args
     # a dry run's plan is its output: Snakemake prints it once, and no job will finish
     progress = P.Progress(c, c["out"], started, None if dry_run else P.pending_jobs(cmd), clock=not a.slurm)
     if not dry_run:

@@ -344,5 +344,37 @@ class NarrowedFits(unittest.TestCase):
         self.assertEqual(X.mean([{"k": "1"}, {"k": "3"}], "k"), 2.0)
 
 
+class Arguments(unittest.TestCase):
+    """experiment.py's flags, refused before anything runs (--frames -3 planned no edit jobs, and
+    the summary rule then emptied an earlier run's results; 0 meant the default)."""
+
+    def refused(self, *args):
+        script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "experiment.py")
+        with tempfile.TemporaryDirectory() as tmp:
+            r = subprocess.run([sys.executable, script, "--out", os.path.join(tmp, "out"), *args],
+                               capture_output=True, text=True)
+            self.assertFalse(os.path.exists(os.path.join(tmp, "out")), args)  # nothing made
+        self.assertEqual(r.returncode, 2, (args, r.stderr))
+        return r.stderr
+
+    def test_bad_values_are_refused_by_name(self):
+        for flag, value in (("--frames", "-3"), ("--frame-step", "0"), ("--chunk", "0"), ("--spp", "-5"),
+                            ("--cores", "0"), ("--fit-iterations", "-10"), ("--image-res", "0")):
+            self.assertIn(f"{flag} must be >= 1, got {value}", self.refused("--quick", flag, value))
+        self.assertIn("multiple of 8", self.refused("--quick", "--image-res", "100"))
+        self.assertIn("--refiner-dropout must be in [0, 0.99]", self.refused("--quick", "--refiner-dropout", "5"))
+        self.assertIn("--emission-decay must be a finite number", self.refused("--quick", "--emission-decay", "nan"))
+        self.assertIn("two presets", self.refused("--quick", "--paper"))
+        with tempfile.NamedTemporaryFile() as f:  # was a FileExistsError traceback
+            self.assertIn("is a file; name a folder", self.refused("--quick", "--out", f.name))
+
+    def test_combined_short_flags_are_a_dry_run(self):
+        sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+        import experiment
+        self.assertTrue(experiment.is_dry_run(["-np"]))
+        self.assertTrue(experiment.is_dry_run(["--dry-run"]))
+        self.assertFalse(experiment.is_dry_run(["--printshellcmds", "-p"]))
+
+
 if __name__ == "__main__":
     unittest.main()
