@@ -1,4 +1,5 @@
 #include "pipeline/fit_checkpoint.h"
+#include "core/fingerprint.h"
 #include "core/image_io.h"
 #include "pipeline/fit_folder.h"
 #include <filesystem>
@@ -7,6 +8,18 @@
 namespace lpt::pipeline {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+/// The file's bytes as a fingerprint (a missing file reads as none: its loader names it).
+std::string text_fingerprint(const std::string& path) {
+    if (!fs::is_regular_file(path)) return "";
+    Fingerprint f;
+    f.add(read_file(path));
+    return "fnv1a64:" + f.hex();
+}
+
+}  // namespace
 
 nlohmann::json stage1_settings(const FitJob& job) {
     const FitOptions& o = job.options;
@@ -30,7 +43,11 @@ nlohmann::json stage1_settings(const FitJob& job) {
                      {"smoothing", o.smoothing},
                      {"reuse_paths", o.reuse_paths},
                      // the VAE the target was encoded by, by content (a rerun with another --vae-*)
-                     {"vae_encoder", job.encode ? vae_encoder_fingerprint(job.vae) : ""}});
+                     {"vae_encoder", job.encode ? vae_encoder_fingerprint(job.vae) : ""},
+                     // the scene's and target's texts, not only their paths: an edited max_depth
+                     // in the file resumed where -D integrator.max_depth was refused
+                     {"scene_text", text_fingerprint(job.scene)},
+                     {"target_file", job.target.empty() ? "" : text_fingerprint(job.target)}});
     return settings;
 }
 
@@ -38,10 +55,12 @@ namespace {
 
 /// Settings added after checkpoints began to record theirs, with the value every checkpoint
 /// made before them had: one without the key resumes when the setting still has that value.
-/// null: the value is not known (the VAE, recorded since session 51), and one without the key
+/// null: the value is not known (the VAE, recorded since session 51; the scene's and target's
+/// texts, since session 55), and one without the key
 /// resumes whatever the setting is now, as it did before.
 const nlohmann::json& settings_added_later() {
-    static const nlohmann::json added = {{"emitter_response_decay", 0.0}, {"vae_encoder", nullptr}};
+    static const nlohmann::json added = {
+        {"emitter_response_decay", 0.0}, {"vae_encoder", nullptr}, {"scene_text", nullptr}, {"target_file", nullptr}};
     return added;
 }
 

@@ -109,6 +109,30 @@ TEST(Pipeline, ResumeRefusesOrRestartsACheckpointOfOtherSettings) {
     EXPECT_THROW(pipeline::run_fit(none), std::runtime_error);
 }
 
+// The scene's text, not only its path: a max_depth edited in the file was resumed, the same
+// change given as -D refused. A checkpoint that records no text resumes as before.
+TEST(Pipeline, ResumeRefusesACheckpointOfAnEditedSceneFile) {
+    const std::string dir = test::temp_dir("pipeline-fit-scene-edited");
+    const std::string scene = dir + "/scene.json";
+    fs::copy_file(std::string(LPT_SOURCE_DIR) + "/scenes/cornell-box/scene.json", scene);
+    pipeline::FitJob job = small_fit(dir + "/fit");
+    job.scene = scene;
+    job.defines.clear();
+    pipeline::run_fit(job);
+    std::string text = read_file(scene);
+    const size_t at = text.find("\"max_depth\": 8");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, 14, "\"max_depth\": 3");
+    std::ofstream(scene) << text;
+    job.resume = true;
+    test::expect_error_naming([&] { pipeline::run_fit(job); }, {"checkpoint/settings.json", "scene_text"},
+                              "resumed a checkpoint of the scene file before its edit");
+    nlohmann::json recorded = nlohmann::json::parse(read_file(job.out + "/checkpoint/settings.json"));
+    recorded.erase("scene_text");  // as checkpoints before session 55 were
+    std::ofstream(job.out + "/checkpoint/settings.json") << recorded.dump();
+    EXPECT_NO_THROW(pipeline::run_fit(job));
+}
+
 // A finished fit rerun with another stage-1 setting starts stage 1 again; killed there and
 // resumed, it must train its refiner again rather than resume the old one's finished checkpoint,
 // which was trained on the old stage 1's renders: it ends as a fresh fit with the new setting.
