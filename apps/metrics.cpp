@@ -199,6 +199,8 @@ void print_text(const std::string& path_a, const std::string& path_b, const Scor
 std::vector<std::pair<std::string, std::string>> read_pairs(const std::string& file) {
     std::ifstream in_file;
     if (file != "-") {
+        // a folder opens as a stream that reads nothing: no scores and exit 0
+        if (fs::is_directory(file)) throw std::runtime_error(file + ": a folder, not a --pairs file");
         in_file.open(file);
         if (!in_file) throw std::runtime_error(file + ": cannot open the --pairs file");
     }

@@ -8,9 +8,10 @@ namespace lpt::app {
 
 std::vector<float> load_rgb(const std::string& path, int factor, int& width, int& height) {
     Image img = read_image(path);
-    if (img.channels < 3)
+    if (img.channels != 3 && img.channels != 4)  // a 16-channel latent compared its first three
         throw std::runtime_error(path + ": expected an RGB image, found " + std::to_string(img.channels) +
                                  " channel(s)");
+    require_finite_pixels(img, path);
     if (img.display)
         throw std::runtime_error(path +
                                  ": holds display values (a reference after fit's tone, or a decoded "

@@ -24,6 +24,7 @@ expect_error "--exposure: expected a finite number" "$bin" render "$scene" --exp
 expect_error "--threads" "$bin" --threads 10000000 render "$scene" --res 8x8 --spp 1 -q --out "$out/s.exr"
 expect_error "excludes --aov" "$bin" render "$scene" --edit "$src/scenes/cornell-box/edits-demo.json" --aov -q --out "$out/s"
 expect_error "--aov-res requires --aov" "$bin" render "$scene" --aov-res 4x4 --res 8x8 --spp 1 -q --out "$out/s.exr"
+expect_error "a folder, not a --pairs file" "$bin" metrics --pairs "$out"
 # A rename onto a folder of the output's name failed and left the temporary beside it.
 mkdir -p "$out/folder.exr"
 expect_error "folder.exr: cannot write image" "$bin" render "$scene" --res 8x8 --spp 1 -q --out "$out/folder.exr"
@@ -157,6 +158,8 @@ if [ -d "$shared/models/taesd3" ]; then
     expect_error "nan.exr: value at pixel (0, 0), channel 0 is not finite" "$bin" encode "$out/nan.exr" -q --out "$out/nan_latent.exr"
     oiiotool --pattern constant:color=0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,nan 2x2 16 -d float -o "$out/nan16.exr"
     expect_error "nan16.exr: value at pixel (0, 0), channel" "$bin" decode "$out/nan16.exr" -q --out "$out/nan.png"
+    expect_error "nan16.exr: value at pixel (0, 0), channel" "$bin" viz "$out/nan16.exr" -q --out "$out/nan.png"
+    expect_error "expected an RGB image, found 16" "$bin" compare --test "$out/nan16.exr" --ref "$out/nan16.exr"
     # Resolutions and frame ranges are whole integers in range: sscanf read '4294967304x8' as 8x8.
     expect_error "--res expects WxH" "$bin" render "$scene" --res 4294967304x8 --spp 1 -q --out "$out/wrap.exr"
     expect_error "--res expects WxH" "$bin" render "$scene" --res 8x8junk --spp 1 -q --out "$out/wrap.exr"

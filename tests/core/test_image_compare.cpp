@@ -85,4 +85,13 @@ TEST(ImageCompare, MismatchedInputsAreErrors) {
     RenderStack empty;
     EXPECT_THROW(compare_renders(empty, a, {}, 4), std::invalid_argument);
     EXPECT_THROW(compare_renders(a, a, std::vector<uint8_t>(3, 0), 4), std::invalid_argument);
+    // One render given twice claims zero noise, and a zero sigma flags no block however biased.
+    RenderStack twice = noisy_stack(8, 8, 2, 0.1, 9), biased = noisy_stack(8, 8, 2, 0.1, 10, 1.2, 0, 4, 0, 4);
+    twice.renders[1] = twice.renders[0];
+    try {
+        compare_renders(twice, biased, {}, 4);
+        ADD_FAILURE() << "a render given twice was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("test: renders 1 and 2 are identical"), std::string::npos) << e.what();
+    }
 }
