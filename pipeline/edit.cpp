@@ -260,6 +260,8 @@ int render_edits(const EditJob& job, const Reporter& report) {
                                     std::to_string(job.height));
     if (!fs::is_directory(job.fitdir))
         throw std::runtime_error(job.fitdir + ": --edit needs a fit folder (made by latentpt fit)");
+    if (job.out.empty() || (fs::exists(job.out) && !fs::is_directory(job.out)))
+        throw std::invalid_argument("render --edit --out '" + job.out + "': not a folder");
     // The frames' key hashes the fit's files as read around the session's loading of them: a fit
     // or refine writing there meanwhile would give frames of the old files the new files' key,
     // which --resume would then keep.

@@ -169,6 +169,10 @@ std::string stage1_summary(const FitState& state, int patience) {
 }  // namespace
 
 void validate(const FitJob& job) {
+    // "" raised the filesystem's "cannot create directories: Invalid argument []"
+    if (job.out.empty()) throw std::invalid_argument("fit --out: the output folder is empty");
+    if (fs::exists(job.out) && !fs::is_directory(job.out))
+        throw std::invalid_argument("fit --out " + job.out + ": a file, not a folder");
     if (job.terms.empty() || job.terms.find_first_not_of("eac") != std::string::npos)
         throw std::invalid_argument("--terms takes letters from e, a, c; got '" + job.terms + "'");
     parameterisation_from_string(job.param);

@@ -9,6 +9,7 @@
 #include "pipeline/vae_source.h"
 #include "vae/vae.h"
 #include <algorithm>
+#include <set>
 #include <pybind11/stl.h>
 
 namespace lpt::python {
@@ -33,6 +34,9 @@ pipeline::Reporter reporter(const py::object& progress_object, const py::object&
             d["seconds"] = p.seconds;
             d["status"] = p.status;
             const py::object keep = progress(d);
+            if (!keep.is_none() && !py::isinstance<py::bool_>(keep))  // "stop" was a cast error's text
+                throw py::type_error("progress callback must return True, False (cancel) or None, got " +
+                                     std::string(py::str(keep.get_type().attr("__name__"))));
             return keep.is_none() || keep.cast<bool>();
         };
     r.note = [note](const std::string& text) {
@@ -138,13 +142,22 @@ bool apply_fit_option(pipeline::FitJob& job, const std::string& k, const py::han
 /// when its value is of the wrong type or it is unknown to `call`.
 template <typename Apply>
 void apply_options(const char* call, const py::dict& options, Apply apply) {
+    static const std::set<std::string> flags = {"encode", "resume", "restart_if_changed", "refiner", "emitters"};
     for (const auto& [key, value] : options) {
         const std::string k = py::str(key);
+        const std::string type = py::str(value.get_type().attr("__name__"));
+        // True is an int to pybind11: iterations=True ran one iteration
+        if (py::isinstance<py::bool_>(value) && !flags.count(k))
+            throw py::type_error(std::string(call) + "(): option '" + k + "' cannot be a bool");
         bool known = false;
         try {
             known = apply(k, value);
         } catch (const py::cast_error&) {
-            const std::string type = py::str(value.get_type().attr("__name__"));
+            if (py::isinstance<py::int_>(value))  // seed=-1: "cannot be a int" said nothing
+                throw py::value_error(
+                    std::string(call) + "(): option '" + k + "' = " + std::string(py::str(value)) +
+                    " is out of its range" +
+                    (k.find("seed") != std::string::npos ? " (0 to 2^64 - 1)" : " (a 32-bit integer)"));
             throw py::type_error(std::string(call) + "(): option '" + k + "' cannot be a " + type);
         }
         if (!known) throw py::type_error(std::string(call) + "() got an unknown option '" + k + "'");
@@ -164,6 +177,12 @@ py::dict run_fit(const std::string& scene, const std::string& out, const std::ma
     job.out = out;
     job.defines = defines;
     apply_fit_options(job, options);
+    // what the CLI refuses as doing nothing alone (docs/reliability.md)
+    for (const char* key : {"encode_res", "ref_spp"})
+        if (options.contains(key) && !job.encode)
+            throw py::value_error(std::string("fit(): option '") + key + "' needs encode=True");
+    if (options.contains("restart_if_changed") && !job.resume)
+        throw py::value_error("fit(): option 'restart_if_changed' needs resume=True");
     pipeline::validate(job);
     const pipeline::Reporter report = reporter(progress, note);
     const pipeline::FitSummary s = without_gil([&] { return pipeline::run_fit(job, report); });

@@ -331,6 +331,25 @@ class GateCoverageTest(unittest.TestCase):
 
 
 class PipelineTest(unittest.TestCase):
+    def test_options_the_cli_would_refuse_are_refused_by_name(self):
+        small = dict(synthetic_res="8x8", iterations=2, spp=1, final_spp=1, refiner=False, note=lambda t: None)
+        with tempfile.TemporaryDirectory() as d:
+            out = os.path.join(d, "fit")
+            for options, error, words in (
+                    (dict(seed=-1), ValueError, "option 'seed' = -1 is out of its range"),  # "cannot be a int"
+                    (dict(iterations=True), TypeError, "option 'iterations' cannot be a bool"),  # ran 1
+                    (dict(encode_res="64x64"), ValueError, "'encode_res' needs encode=True"),
+                    (dict(restart_if_changed=True), ValueError, "'restart_if_changed' needs resume=True"),
+                    (dict(progress=lambda p: "stop"), TypeError, "progress callback must return True, False")):
+                with self.assertRaisesRegex(error, words):
+                    latentpt.fit(BOX, out, **dict(small, **options))
+            with self.assertRaisesRegex(ValueError, "the output folder is empty"):  # a filesystem error
+                latentpt.fit(BOX, "", **small)
+            with open(os.path.join(d, "file"), "w"):
+                pass
+            with self.assertRaisesRegex(ValueError, "a file, not a folder"):
+                latentpt.fit(BOX, os.path.join(d, "file"), **small)
+
     def test_fit_reports_progress_and_cancels_cleanly(self):
         with tempfile.TemporaryDirectory() as d:
             steps = []
