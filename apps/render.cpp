@@ -12,6 +12,8 @@
 namespace lpt::app {
 
 namespace {
+constexpr int kPngMaxSide = 1000000;  // PNG_USER_WIDTH_MAX and PNG_USER_HEIGHT_MAX
+
 std::string with_suffix(const std::string& exr_path, const std::string& suffix_ext) {
     std::filesystem::path p(exr_path);
     return (p.parent_path() / (p.stem().string() + suffix_ext)).string();
@@ -26,6 +28,20 @@ int run_render(const RenderArgs& a) {
     if (a.spp > 0) opt.spp = a.spp;
     if (a.max_depth != -2) opt.max_depth = a.max_depth;
     if (!a.res.empty()) parse_resolution(a.res, opt.width, opt.height, "--res");
+    {  // before the render: a size found too large after it cost the render (or left the EXR alone)
+        const int w = opt.width > 0 ? opt.width : scene.camera.width,
+                  h = opt.height > 0 ? opt.height : scene.camera.height;
+        const char* flag = a.res.empty() ? "the scene's camera" : "--res";
+        try {
+            check_image_fits(w, h, 2 * 3 + 1);  // the film's floats a pixel
+        } catch (const std::length_error& e) {
+            throw std::invalid_argument(std::string(flag) + ": " + e.what());
+        }
+        if (w > kPngMaxSide || h > kPngMaxSide)  // libpng's limit: the EXR would be written, its preview not
+            throw std::invalid_argument(std::string(flag) + ": " + std::to_string(w) + "x" + std::to_string(h) +
+                                        " is beyond the PNG preview's " + std::to_string(kPngMaxSide) +
+                                        " pixels a side");
+    }
     // the AOVs' size is checked before the render, not found too large after it
     int aw = opt.width, ah = opt.height;
     if (a.aov && !a.aov_res.empty()) {

@@ -1,5 +1,6 @@
 #include "pipeline/fit.h"
 #include "autodiff/loss.h"
+#include "core/film.h"
 #include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
@@ -205,9 +206,15 @@ void validate(const FitJob& job) {
             throw std::invalid_argument(std::string(flag) + " must be a finite number >= 0, got " +
                                         std::to_string(value));
     int w = 0, h = 0;  // checked here, before run_fit touches an existing folder's checkpoint
-    if (job.target.empty())
-        parse_resolution(job.encode ? job.encode_res : job.synthetic_res, w, h,
-                         job.encode ? "--encode-res" : "--synthetic-res");
+    if (job.target.empty()) {
+        const char* flag = job.encode ? "--encode-res" : "--synthetic-res";
+        parse_resolution(job.encode ? job.encode_res : job.synthetic_res, w, h, flag);
+        try {  // the latents' renders and adjoint (synthetic), or the RGB reference (encode)
+            check_image_fits(w, h, job.encode ? 3 : 2 * kLatentChannels + 1);
+        } catch (const std::length_error& e) {
+            throw std::invalid_argument(std::string(flag) + ": " + e.what());
+        }
+    }
     if (job.refiner) validate(job.refine);
 }
 

@@ -25,6 +25,11 @@ expect_error "--threads" "$bin" --threads 10000000 render "$scene" --res 8x8 --s
 expect_error "excludes --aov" "$bin" render "$scene" --edit "$src/scenes/cornell-box/edits-demo.json" --aov -q --out "$out/s"
 expect_error "--aov-res requires --aov" "$bin" render "$scene" --aov-res 4x4 --res 8x8 --spp 1 -q --out "$out/s.exr"
 expect_error "a folder, not a --pairs file" "$bin" metrics --pairs "$out"
+# Sizes beyond memory or a PNG's limit name their flag, before any work.
+expect_error "--res: an image of 65536x65536 pixels needs" "$bin" render "$scene" --res 65536x65536 --spp 1 -q --out "$out/s.exr"
+expect_error "--res: 1x1000001 is beyond the PNG preview" "$bin" render "$scene" --res 1x1000001 --spp 1 -q --out "$out/s.exr"
+expect_error "--synthetic-res: an image of 65536x65536 pixels needs" "$bin" fit "$scene" --synthetic-res 65536x65536 --no-refiner -q --out "$out/s_fit"
+check test ! -e "$out/s_fit"
 # A rename onto a folder of the output's name failed and left the temporary beside it.
 mkdir -p "$out/folder.exr"
 expect_error "folder.exr: cannot write image" "$bin" render "$scene" --res 8x8 --spp 1 -q --out "$out/folder.exr"
