@@ -157,9 +157,15 @@ struct Cli {
             ->capture_default_str()
             ->check(CLI::Range(4, 256))
             ->needs(equal_noise);
-        bench->add_flag("--startup", b.startup,
-                        "seconds from exec to exit of --help, a 1-spp 16x16 render and commands that open the "
-                        "torch or image plugin (median and minimum of 10 runs each)");
+        auto* startup =
+            bench->add_flag("--startup", b.startup,
+                            "seconds from exec to exit of --help, a 1-spp 16x16 render and commands that open the "
+                            "torch or image plugin (median and minimum of 10 runs each)");
+        // one mode a run: --fit --startup ran the start-up alone
+        const std::vector<CLI::Option*> modes = {fit_flag, equal_error, equal_noise, startup};
+        for (CLI::Option* a : modes)
+            for (CLI::Option* other : modes)
+                if (a != other) a->excludes(other);
         bench->add_option("--seeds", b.seeds, "with --equal-noise: renders per ladder point")
             ->capture_default_str()
             ->check(positive())
@@ -271,18 +277,26 @@ struct Cli {
         fit->add_option("scene", f.job.scene, "scene file (.json or Mitsuba 3 .xml)")
             ->required()
             ->check(CLI::ExistingFile);
-        fit->add_option("--target", f.job.target,
-                        "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
-                        "without it, a synthetic target rendered from random parameters")
-            ->check(CLI::ExistingFile);
+        auto* target =
+            fit->add_option(
+                   "--target", f.job.target,
+                   "16-channel float EXR at latent resolution (channels C00..C15; C0..C15 also read in order); "
+                   "without it, a synthetic target rendered from random parameters")
+                ->check(CLI::ExistingFile);
         fit->add_option("-o,--out", f.job.out, "output folder")->capture_default_str();
-        fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")
-            ->capture_default_str();
-        fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
-            ->capture_default_str()
-            ->check(seed_value());
+        auto* synthetic_res =
+            fit->add_option("--synthetic-res", f.job.synthetic_res, "latent resolution WxH of the synthetic target")
+                ->capture_default_str();
+        auto* synthetic_seed =
+            fit->add_option("--synthetic-seed", f.job.synthetic_seed, "seed of the synthetic target's parameters")
+                ->capture_default_str()
+                ->check(seed_value());
         add_fit_model();
         add_fit_optimisation();
+        // Three targets, one taken: the others' options would be ignored without a word.
+        CLI::Option* encode = fit->get_option("--encode");
+        for (CLI::Option* synthetic : {synthetic_res, synthetic_seed}) synthetic->excludes(target)->excludes(encode);
+        target->excludes(encode);
     }
 
     void add_refine(CLI::App& app) {
@@ -353,10 +367,11 @@ struct Cli {
             ->add_option("--ref", cmp.ref, "reference render(s), same size or an integer multiple (box-averaged down)")
             ->required()
             ->check(CLI::ExistingFile);
-        compare
-            ->add_option("--scene", cmp.scene, "scene of the renders: pixels that see an emitter directly are left out")
-            ->check(CLI::ExistingFile);
-        compare->add_option("-D,--define", cmp_defines, "scene override, as for render");
+        auto* scene = compare
+                          ->add_option("--scene", cmp.scene,
+                                       "scene of the renders: pixels that see an emitter directly are left out")
+                          ->check(CLI::ExistingFile);
+        compare->add_option("-D,--define", cmp_defines, "with --scene: scene override, as for render")->needs(scene);
         add_number(compare, "--block", cmp.block, "block side in pixels", positive());
         add_number(compare, "--sigma", cmp.sigma,
                    "flag blocks whose ratio is this many standard deviations of its noise from 1", positive());

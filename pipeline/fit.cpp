@@ -194,6 +194,7 @@ void validate(const FitJob& job) {
     require(job.final_spp > 0, "--final-spp", "> 0", job.final_spp);
     require(o.lr > 0.f && std::isfinite(o.lr), "--lr", "> 0", o.lr);
     require(o.lr_min >= 0.f && std::isfinite(o.lr_min), "--lr-min", ">= 0", o.lr_min);
+    require(o.lr_min <= o.lr, "--lr-min", "<= --lr (the schedule falls from --lr to it)", o.lr_min);
     require(o.lr_period > 0, "--lr-period", "> 0", o.lr_period);
     require(o.patience >= 0, "--patience", ">= 0", o.patience);
     require(o.min_delta >= 0.f && std::isfinite(o.min_delta), "--min-delta", ">= 0", o.min_delta);

@@ -25,6 +25,11 @@ expect_error "--threads" "$bin" --threads 10000000 render "$scene" --res 8x8 --s
 expect_error "excludes --aov" "$bin" render "$scene" --edit "$src/scenes/cornell-box/edits-demo.json" --aov -q --out "$out/s"
 expect_error "--aov-res requires --aov" "$bin" render "$scene" --aov-res 4x4 --res 8x8 --spp 1 -q --out "$out/s.exr"
 expect_error "a folder, not a --pairs file" "$bin" metrics --pairs "$out"
+# Options of another mode than the one chosen did nothing without a word.
+expect_error "--target excludes --synthetic-res" "$bin" fit "$scene" --target "$out/r.exr" --synthetic-res 16x16 -q --out "$out/s_fit"
+expect_error "--fit excludes --startup" "$bin" bench --fit --startup
+expect_error "--define requires --scene" "$bin" compare --test "$out/r.exr" --ref "$out/r.exr" -D x=1
+expect_error "--lr-min must be <= --lr" "$bin" fit "$scene" --lr-min 1 --lr 0.001 --synthetic-res 8x8 -q --out "$out/s_fit"
 # Sizes beyond memory or a PNG's limit name their flag, before any work.
 expect_error "--res: an image of 65536x65536 pixels needs" "$bin" render "$scene" --res 65536x65536 --spp 1 -q --out "$out/s.exr"
 expect_error "--res: 1x1000001 is beyond the PNG preview" "$bin" render "$scene" --res 1x1000001 --spp 1 -q --out "$out/s.exr"
