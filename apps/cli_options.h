@@ -59,15 +59,20 @@ inline CLI::Validator seed_value() {
 
 /// The autoencoder: native TAESD3 weights, or any VAE exported to TorchScript (tools/export_vae.py).
 inline void add_vae_options(CLI::App* sc, VaeSource& vs) {
-    sc->add_option("--vae-dir", vs.dir,
-                   "TAESD3 weights folder, <name>_encoder/_decoder.safetensors (default: ../shared/models/taesd3)");
-    sc->add_option("--vae-encoder", vs.encoder,
-                   "TorchScript encoder module (with --vae-decoder, --vae-config; e.g. the SD3.5 VAE)")
-        ->check(CLI::ExistingFile);
-    sc->add_option("--vae-decoder", vs.decoder, "TorchScript decoder module")->check(CLI::ExistingFile);
-    sc->add_option("--vae-config", vs.config,
-                   "vae.json of the TorchScript VAE: channels, downsample, scale, shift, image_range, latent")
-        ->check(CLI::ExistingFile);
+    auto* dir = sc->add_option("--vae-dir", vs.dir,
+                               "TAESD3 weights folder holding taesd3_encoder.safetensors and "
+                               "taesd3_decoder.safetensors (default: ../shared/models/taesd3); other VAEs (TAEF1, "
+                               "SD3.5's) through --vae-encoder, --vae-decoder, --vae-config");
+    // --vae-dir beside a TorchScript VAE was ignored
+    for (auto* ts :
+         {sc->add_option("--vae-encoder", vs.encoder,
+                         "TorchScript encoder module (with --vae-decoder, --vae-config; e.g. the SD3.5 VAE)")
+              ->check(CLI::ExistingFile),
+          sc->add_option("--vae-decoder", vs.decoder, "TorchScript decoder module")->check(CLI::ExistingFile),
+          sc->add_option("--vae-config", vs.config,
+                         "vae.json of the TorchScript VAE: channels, downsample, scale, shift, image_range, latent")
+              ->check(CLI::ExistingFile)})
+        ts->excludes(dir);
 }
 
 /// A number option that shows its default and checks its range.

@@ -446,6 +446,7 @@ int main(int argc, char** argv) {
     lpt::app::Cli cli;
     CLI::App app{"latentpt: a differentiable path tracer that renders into the latent space of an image autoencoder"};
     app.require_subcommand(1);
+    app.fallthrough();  // `render ... --threads 1` as well as `--threads 1 render ...`
     // 10^7 threads took 1.3 GB before the first pixel; 4096 is past any machine's cores
     app.add_option("--threads", cli.threads, "worker threads (default: all cores)")->check(CLI::Range(1, 4096));
     app.add_option("--sampler", cli.sampler,

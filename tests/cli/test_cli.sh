@@ -25,6 +25,9 @@ expect_error "--threads" "$bin" --threads 10000000 render "$scene" --res 8x8 --s
 expect_error "excludes --aov" "$bin" render "$scene" --edit "$src/scenes/cornell-box/edits-demo.json" --aov -q --out "$out/s"
 expect_error "--aov-res requires --aov" "$bin" render "$scene" --aov-res 4x4 --res 8x8 --spp 1 -q --out "$out/s.exr"
 expect_error "a folder, not a --pairs file" "$bin" metrics --pairs "$out"
+# The top-level options after the subcommand too ("not expected: 1 --threads" before).
+"$bin" render "$scene" --res 8x8 --spp 1 -q --out "$out/t.exr" --threads 1 --sampler independent; check test -s "$out/t.exr"
+expect_error "--vae-dir excludes --vae-encoder" "$bin" encode "$out/r.exr" --vae-dir "$out" --vae-encoder "$out/r.exr" -q --out "$out/z.exr"
 # Options of another mode than the one chosen did nothing without a word.
 expect_error "--target excludes --synthetic-res" "$bin" fit "$scene" --target "$out/r.exr" --synthetic-res 16x16 -q --out "$out/s_fit"
 expect_error "--fit excludes --startup" "$bin" bench --fit --startup
