@@ -5,6 +5,7 @@
 #include "apps/commands.h"
 #include "apps/torch_commands.h"
 #include "core/process_memory.h"
+#include "core/temp_file.h"
 #include "integrators/path.h"
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -442,7 +443,8 @@ struct Cli {
 }  // namespace lpt::app
 
 int main(int argc, char** argv) {
-    lpt::reuse_freed_memory();  // before any thread: the networks' large blocks stay on the heap
+    lpt::reuse_freed_memory();               // before any thread: the networks' large blocks stay on the heap
+    lpt::remove_temporaries_on_interrupt();  // Ctrl-C while an output is written leaves no temporary
     lpt::app::Cli cli;
     CLI::App app{"latentpt: a differentiable path tracer that renders into the latent space of an image autoencoder"};
     app.require_subcommand(1);

@@ -1,4 +1,5 @@
 #include "core/image_io.h"
+#include "core/temp_file.h"
 #include "core/error.h"
 #include "core/film.h"
 #include "core/image_reader.h"
@@ -38,6 +39,7 @@ std::string temp_path_for(const std::string& path) {
 template <typename Write>
 void write_atomically(const std::string& path, Write write, const char* what = "image") {
     const std::string tmp = temp_path_for(path);
+    const TemporaryFile removed_if_interrupted(tmp);
     try {
         if (fs::path(path).has_parent_path()) fs::create_directories(fs::path(path).parent_path());
         write(tmp);
