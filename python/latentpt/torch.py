@@ -42,7 +42,9 @@ def render_latent(model, raw, width=0, height=0, spp=16, seed=0):
     """The tone-mapped latent (height, width, 16) of `model` with raw parameters `raw` (a 1-D
     tensor laid out as model.raw), on raw's device and in its dtype (computed in float32 on the
     CPU); 0 = the model's latent resolution. Differentiable in `raw`, once: the gradient itself
-    is not differentiable."""
+    is not differentiable. Both passes write `raw` into the model (model.raw): backward puts the
+    forward pass's values back, so that the adjoint replays the paths the forward traced, and a
+    model.raw = ... made between the two is undone by it."""
     if not isinstance(raw, torch.Tensor) or not raw.is_floating_point():
         # an integer tensor would come back as a latent truncated to integers, with no gradient
         raise TypeError("render_latent: raw must be a floating-point torch.Tensor, got "
