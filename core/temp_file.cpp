@@ -1,6 +1,7 @@
 #include "core/temp_file.h"
 #include <atomic>
 #include <csignal>
+#include <signal.h>
 #include <cstring>
 #include <unistd.h>
 
@@ -47,7 +48,16 @@ TemporaryFile::~TemporaryFile() {
 }
 
 void remove_temporaries_on_interrupt() {
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, remove_temporaries_and_reraise);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction old {};
+        // nohup, and a shell's background jobs, ignore some of these: they must stay ignored
+        if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;
+        struct sigaction act {};
+        act.sa_handler = remove_temporaries_and_reraise;
+        sigemptyset(&act.sa_mask);
+        act.sa_flags = SA_RESTART;
+        ::sigaction(sig, &act, nullptr);
+    }
 }
 
 }  // namespace lpt

@@ -23,7 +23,8 @@ private:
 };
 
 /// SIGINT, SIGTERM and SIGHUP remove every registered temporary, then end the process as the
-/// signal would have (the default action, so the exit status still says which signal).
+/// signal would have (the default action, so the exit status still says which signal). A signal
+/// the process inherited as ignored (nohup, a shell's background job) stays ignored.
 void remove_temporaries_on_interrupt();
 
 }  // namespace lpt

@@ -42,3 +42,24 @@ TEST(TemporaryFile, AnInterruptRemovesTheRegisteredOnesAndEndsByItsSignal) {
     EXPECT_TRUE(fs::exists(kept));
     EXPECT_TRUE(fs::exists(done)) << "a released registration was removed";
 }
+
+// nohup ignores SIGHUP for the process it starts: installing the handler must not undo that.
+TEST(TemporaryFile, AnIgnoredSignalStaysIgnored) {
+    const std::string dir = test::temp_dir("temp-file-ignored");
+    const std::string writing = dir + "/.out.tmp.exr";
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        std::signal(SIGHUP, SIG_IGN);
+        remove_temporaries_on_interrupt();
+        touch(writing);
+        const TemporaryFile in_progress(writing);
+        std::raise(SIGHUP);
+        ::_exit(3);  // reached: the hang-up was ignored
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status)) << "the ignored SIGHUP ended the process";
+    EXPECT_EQ(WEXITSTATUS(status), 3);
+    EXPECT_TRUE(fs::exists(writing));
+}
