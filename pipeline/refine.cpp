@@ -322,6 +322,23 @@ int inference_window(const RefineJob& job, const RefinerInput& in) {
     return crop < in.width || crop < in.height ? crop : 0;
 }
 
+/// The kept weights must refine their own training view: --lr 1e30 took one step to weights
+/// whose output's latent MSE was 4e61 (every later step refused), and wrote them with exit 0.
+/// A trained refiner lowers its input's error there; 100 times it is far beyond any that learnt.
+void require_trained(const RefineJob& job, const RefinerInput& in, const std::vector<float>& refined,
+                     const Image& target) {
+    double before = 0, after = 0;
+    for (size_t i = 0; i < refined.size(); ++i) {
+        before += double(in.latent[i] - target.data[i]) * double(in.latent[i] - target.data[i]);
+        after += double(refined[i] - target.data[i]) * double(refined[i] - target.data[i]);
+    }
+    if (std::isfinite(after) && after <= 100.0 * std::max(before, 1e-12 * double(refined.size()))) return;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "latent squared error %.3g against its input's %.3g", after, before);
+    throw std::runtime_error(job.fitdir + ": the trained refiner ruins its own training view (" + buf +
+                             "): a learning rate too large?; nothing written");
+}
+
 /// What a trained refiner leaves in the fit folder: its weights and loss history, and for the
 /// main refiner the refined training view and metrics.json (in s.metrics); an emitter refiner's
 /// record is added to metrics.json, whose other records stay.
@@ -331,9 +348,7 @@ void write_results(const RefineJob& job, const RefinerFiles& files, const Refine
     std::vector<float> refined;
     if (!job.emitters) {
         refined = refiner.refine(in);
-        if (!check_finite(refined.data(), refined.size()))
-            throw std::runtime_error(
-                job.fitdir + ": the trained refiner's output of the training view is not finite; nothing written");
+        require_trained(job, in, refined, target);
     }
     refiner.save(files.weights.string());
     write_text_atomic(files.loss.string(), refiner_csv(s.result));
@@ -455,16 +470,13 @@ RefineSummary run_refine(const RefineJob& job, const Reporter& report) {
                    "\"Augmentation\")");
     s.result = refiner->train(examples, judges.vae.get(), judges.lpips.get(), o, on_iteration);
     if (cancelled) throw Cancelled("refine");
-    // Refused steps keep the weights: a last one refused for its loss means the weights to be
-    // saved give a non-finite loss (--lr 1e30: one step to huge weights, every later one
-    // refused); all refused, they were never trained. Either was written with exit 0.
+    // Every step refused (a NaN in the loss weights' reach): the weights were never trained, and
+    // were written with exit 0. (A resumed history reads as taken: it holds no refusals.)
     const std::vector<RefinerRecord>& h = s.result.history;
-    const bool none_taken = std::all_of(h.begin(), h.end(), [](const RefinerRecord& r) { return r.refused; });
-    if (!h.empty() && (none_taken || !std::isfinite(h.back().loss)))
-        throw std::runtime_error(job.fitdir + ": the refiner's " +
-                                 (none_taken ? "every step was refused" : "loss at its last step is not finite") +
-                                 " (the loss or a gradient not finite); nothing written: check --lr and the loss "
-                                 "weights");
+    if (!h.empty() && std::all_of(h.begin(), h.end(), [](const RefinerRecord& r) { return r.refused; }))
+        throw std::runtime_error(job.fitdir +
+                                 ": the refiner refused every step (its loss or a gradient was not finite); nothing "
+                                 "written: check --lr and the loss weights");
     char best[96];
     std::snprintf(best, sizeof best, "[refine] best smoothed loss %.5f at iteration %d", s.result.best_loss,
                   s.result.best_iteration);

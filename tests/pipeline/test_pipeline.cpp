@@ -481,7 +481,7 @@ TEST(Pipeline, ARefinerThatCannotTrainIsAnError) {
     }
     pipeline::RefineJob huge_lr = good;
     huge_lr.train.lr = 1e30f;
-    test::expect_error_naming([&] { pipeline::run_refine(huge_lr); }, {"not finite"});
+    test::expect_error_naming([&] { pipeline::run_refine(huge_lr); }, {"ruins its own training view"});
     EXPECT_FALSE(fs::exists(good.fitdir + "/refiner.pt"));
 
     Image target = read_image(good.fitdir + "/target.exr");
