@@ -153,7 +153,12 @@ void apply_options(const char* call, const py::dict& options, Apply apply) {
         try {
             known = apply(k, value);
         } catch (const py::cast_error&) {
-            if (py::isinstance<py::int_>(value))  // seed=-1: "cannot be a int" said nothing
+            // seed=-1 said "cannot be a int": an int the option takes (0 casts) failed on its range
+            bool takes_ints = false;
+            if (py::isinstance<py::int_>(value)) try {
+                    takes_ints = apply(k, py::int_(0));  // the job is thrown away with the error below
+                } catch (const py::cast_error&) {}
+            if (takes_ints)
                 throw py::value_error(
                     std::string(call) + "(): option '" + k + "' = " + std::string(py::str(value)) +
                     " is out of its range" +
@@ -178,10 +183,13 @@ py::dict run_fit(const std::string& scene, const std::string& out, const std::ma
     job.defines = defines;
     apply_fit_options(job, options);
     // what the CLI refuses as doing nothing alone (docs/reliability.md)
-    for (const char* key : {"encode_res", "ref_spp"})
-        if (options.contains(key) && !job.encode)
-            throw py::value_error(std::string("fit(): option '") + key + "' needs encode=True");
-    if (options.contains("restart_if_changed") && !job.resume)
+    // by value, not by presence: a wrapper that passes every option at its default is fine
+    const pipeline::FitJob defaults;
+    if (!job.encode && (job.encode_res != defaults.encode_res || job.ref_spp != defaults.ref_spp))
+        throw py::value_error(std::string("fit(): option '") +
+                              (job.encode_res != defaults.encode_res ? "encode_res" : "ref_spp") +
+                              "' needs encode=True");
+    if (job.restart_if_changed && !job.resume)
         throw py::value_error("fit(): option 'restart_if_changed' needs resume=True");
     pipeline::validate(job);
     const pipeline::Reporter report = reporter(progress, note);
@@ -233,10 +241,11 @@ py::array_t<float> encode(const PyVae& v, const py::array_t<float, py::array::c_
         throw py::value_error("encode: the image must be at least " + std::to_string(f) + "x" + std::to_string(f) +
                               ", got " + std::to_string(w) + "x" + std::to_string(h));
     std::vector<float> in = from_numpy(rgb, {h, w, 3}, "encode: rgb"), out;
-    // Display values: 0-255 bytes read as floats gave latents of +-700 without a word.
+    // Display values: 0-255 bytes read as floats gave latents of +-700 without a word. A decoded
+    // image (not clamped, about [-0.1, 1.2]) must still go back in.
     const auto [lo, hi] = std::minmax_element(in.begin(), in.end());
-    if (*lo < -1e-3f || *hi > 1.f + 1e-3f)
-        throw py::value_error("encode: rgb must be display values in [0, 1], got [" + std::to_string(*lo) + ", " +
+    if (*lo < -0.5f || *hi > 1.5f)
+        throw py::value_error("encode: rgb must be display values, about [0, 1], got [" + std::to_string(*lo) + ", " +
                               std::to_string(*hi) + "] (8-bit images: divide by 255)");
     {
         py::gil_scoped_release unlocked;

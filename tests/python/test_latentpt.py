@@ -235,7 +235,8 @@ class VaeTest(unittest.TestCase):
         bad[1, 2, 0] = np.nan  # passed through as NaN latents
         with self.assertRaisesRegex(ValueError, r"encode: rgb: the value at \(1, 2, 0\) is not finite"):
             vae.encode(bad)
-        with self.assertRaisesRegex(ValueError, r"display values in \[0, 1\].*divide by 255"):
+        vae.encode(np.clip(vae.decode(vae.encode(grey)) * 1.15 - 0.05, -0.2, 1.3))  # decoded: not clamped
+        with self.assertRaisesRegex(ValueError, r"display values, about \[0, 1\].*divide by 255"):
             vae.encode(np.full((16, 16, 3), 200, np.uint8))  # latents of +-700
         with self.assertRaisesRegex(ValueError, "at least 8x8, got 0x0"):
             vae.encode(np.zeros((0, 0, 3), np.float32))  # torch's C++ stack trace
@@ -340,9 +341,12 @@ class PipelineTest(unittest.TestCase):
                     (dict(iterations=True), TypeError, "option 'iterations' cannot be a bool"),  # ran 1
                     (dict(encode_res="64x64"), ValueError, "'encode_res' needs encode=True"),
                     (dict(restart_if_changed=True), ValueError, "'restart_if_changed' needs resume=True"),
-                    (dict(progress=lambda p: "stop"), TypeError, "progress callback must return True, False")):
+                    (dict(progress=lambda p: "stop"), TypeError, "progress callback must return True, False"),
+                    (dict(terms=1), TypeError, "option 'terms' cannot be a int")):
                 with self.assertRaisesRegex(error, words):
                     latentpt.fit(BOX, out, **dict(small, **options))
+            # options at their defaults are no request: a wrapper may pass them all
+            latentpt.fit(BOX, out, **dict(small, restart_if_changed=False, encode_res="256x256", ref_spp=256))
             with self.assertRaisesRegex(ValueError, "the output folder is empty"):  # a filesystem error
                 latentpt.fit(BOX, "", **small)
             with open(os.path.join(d, "file"), "w"):
