@@ -80,6 +80,14 @@ nlohmann::json to_json(const ImageComparison& c, const CompareArgs& a) {
 
 int run_compare(const CompareArgs& a) {
     if (a.test.empty() || a.ref.empty()) throw std::invalid_argument("compare needs --test and --ref images");
+    // a file given twice on a side is no second render: its noise would read as zero
+    for (const auto* side : {&a.test, &a.ref})
+        for (size_t i = 0; i < side->size(); ++i)
+            for (size_t j = i + 1; j < side->size(); ++j)
+                if (std::error_code ec; fs::equivalent((*side)[i], (*side)[j], ec))
+                    throw std::invalid_argument((*side)[j] + ": given twice to " +
+                                                (side == &a.test ? "--test" : "--ref") +
+                                                "; the noise estimate needs independent renders (other seeds)");
     RenderStack test = load_stack(a.test, 0);
     RenderStack ref = load_stack(a.ref, test.width);
     if (ref.height != test.height)

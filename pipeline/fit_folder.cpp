@@ -178,9 +178,9 @@ Image read_fit_image(const std::string& path, int channels, int w, int h) {
     Image img = read_image(path);
     if (img.channels != channels || (w > 0 && (img.width != w || img.height != h)))
         throw std::runtime_error(path + ": expected " +
-                                 (w > 0 ? std::to_string(w) + "x" + std::to_string(h) + "x" : std::string()) +
+                                 (w > 0 ? std::to_string(w) + "x" + std::to_string(h) + " with " : std::string()) +
                                  std::to_string(channels) + " channels, found " + std::to_string(img.width) + "x" +
-                                 std::to_string(img.height) + "x" + std::to_string(img.channels));
+                                 std::to_string(img.height) + " with " + std::to_string(img.channels));
     require_finite_pixels(img, path);  // a NaN target let the refiner refuse every step, exit 0
     return img;
 }

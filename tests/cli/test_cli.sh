@@ -31,6 +31,7 @@ expect_error "--vae-dir excludes --vae-encoder" "$bin" encode "$out/r.exr" --vae
 # Options of another mode than the one chosen did nothing without a word.
 expect_error "--target excludes --synthetic-res" "$bin" fit "$scene" --target "$out/r.exr" --synthetic-res 16x16 -q --out "$out/s_fit"
 expect_error "--fit excludes --startup" "$bin" bench --fit --startup
+expect_error "given twice to --test" "$bin" compare --test "$out/r.exr" "$out/r.exr" --ref "$out/r.exr"
 expect_error "--define requires --scene" "$bin" compare --test "$out/r.exr" --ref "$out/r.exr" -D x=1
 expect_error "--lr-min must be <= --lr" "$bin" fit "$scene" --lr-min 1 --lr 0.001 --synthetic-res 8x8 -q --out "$out/s_fit"
 # Sizes beyond memory or a PNG's limit name their flag, before any work.
@@ -74,11 +75,16 @@ for f in params.json latent.exr latent_e.exr latent_a.exr latent_c.exr aov.exr l
 done
 check test "$(wc -l < "$out/fit/loss.csv")" -eq 21
 check test "$(wc -l < "$out/fit/refiner_loss.csv")" -eq 5
-"$bin" fit "$scene" --synthetic-res 8x8 --iterations 30 --spp 2 --final-spp 4 -q -D integrator.max_depth=3 --out "$out/fit" --resume --no-refiner
-check test "$(wc -l < "$out/fit/loss.csv")" -eq 31
-# Stage 2 on its own continues from its checkpoint.
+# Stage 2 on its own continues from its checkpoint: its first rows, seconds included, stay.
+head -5 "$out/fit/refiner_loss.csv" > "$out/refiner_loss_before.csv"
 "$bin" refine "$out/fit" --iterations 6 --expansion 1 -q --resume
 check test "$(wc -l < "$out/fit/refiner_loss.csv")" -eq 7
+check cmp -s "$out/refiner_loss_before.csv" <(head -5 "$out/fit/refiner_loss.csv")
+# A stage 1 that takes steps makes the refiner stale: without --refiner it is removed, not kept.
+"$bin" fit "$scene" --synthetic-res 8x8 --iterations 30 --spp 2 --final-spp 4 -q -D integrator.max_depth=3 --out "$out/fit" --resume --no-refiner
+check test "$(wc -l < "$out/fit/loss.csv")" -eq 31
+check test ! -e "$out/fit/refiner.pt"
+check test ! -e "$out/fit/refiner_checkpoint.pt"
 expect_error "latent.exr" "$bin" refine "$out" -q
 # A fit folder in use by another process (here util-linux flock holds its lock) is refused at once.
 if command -v flock >/dev/null; then
