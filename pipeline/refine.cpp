@@ -345,11 +345,8 @@ void require_trained(const RefineJob& job, const RefinerInput& in, const std::ve
 void write_results(const RefineJob& job, const RefinerFiles& files, const Refiner& refiner, const RefinerInput& in,
                    const Image& target, const Judges& judges, RefineSummary& s) {
     const fs::path dir(job.fitdir);
-    std::vector<float> refined;
-    if (!job.emitters) {
-        refined = refiner.refine(in);
-        require_trained(job, in, refined, target);
-    }
+    const std::vector<float> refined = refiner.refine(in);  // either refiner's, judged alike
+    require_trained(job, in, refined, target);
     refiner.save(files.weights.string());
     write_text_atomic(files.loss.string(), refiner_csv(s.result));
     const nlohmann::json before = existing_metrics(dir, job.emitters);

@@ -1,6 +1,7 @@
 // Refiner network: construction, inference, and the refiner.pt file (a torch::serialize
 // archive holding the weights and the RefinerConfig, written atomically).
 #include "refiner/refiner_net.h"
+#include "core/temp_file.h"
 #include "vae/torch_threads.h"
 #include <algorithm>
 #include <filesystem>
@@ -202,6 +203,7 @@ void Refiner::save(const std::string& path) const {
     if (c.terms) ar.write("config.terms", c10::IValue(int64_t(1)));  // files without terms as before
     if (c.emitter_cells) ar.write("config.emitter_cells", c10::IValue(int64_t(c.emitter_cells)));  // else as before
     const std::string tmp = path + ".tmp";
+    const TemporaryFile removed_if_interrupted(tmp);  // Ctrl-C while saving leaves no .tmp
     ar.save_to(tmp);
     std::filesystem::rename(tmp, path);
 }

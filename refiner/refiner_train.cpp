@@ -4,6 +4,7 @@
 // noise are functions of (seed, iteration), so a resumed run repeats the same iterations as an
 // uninterrupted one.
 #include "autodiff/lr_schedule.h"
+#include "core/temp_file.h"
 #include "core/sampler.h"
 #include "refiner/refiner_net.h"
 #include "vae/lpips_torch.h"
@@ -149,6 +150,7 @@ void save_checkpoint(const std::string& path, RefinerNet& net, const RefinerConf
     ar.write("stop", torch::tensor({s.stop.best_loss(), double(s.stop.best_iteration()), double(s.stop.bad_updates())},
                                    torch::kFloat64));
     const std::string tmp_path = path + ".tmp";
+    const TemporaryFile removed_if_interrupted(tmp_path);  // Ctrl-C while saving leaves no .tmp
     ar.save_to(tmp_path);
     std::filesystem::rename(tmp_path, path);
 }
