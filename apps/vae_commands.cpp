@@ -19,12 +19,6 @@ void require_rgb(const Image& img, const std::string& path) {
         throw std::runtime_error(path + ": needs 3 channels (RGB) or 4 (RGBA), has " + std::to_string(img.channels));
 }
 
-std::string lower_extension(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 }  // namespace
 
 int run_encode(const VaeArgs& a) {

@@ -51,12 +51,6 @@ void write_atomically(const std::string& path, Write write, const char* what = "
     }
 }
 
-std::string lower_extension(const std::string& path) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext;
-}
-
 /// The names OpenImageIO gave channels when it wrote our EXRs (kept, so files stay the same):
 /// Y; R,G; R,G,B; R,G,B,A; beyond four C00..C{n-1}, zero-padded because EXR stores channels
 /// sorted by name and C10 would come before C2.
@@ -90,6 +84,12 @@ void reorder_numbered_channels(Image& img) {
     img.channel_names = std::move(names);
 }
 }  // namespace
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
 
 float linear_to_srgb(float v) {
     v = std::clamp(v, 0.f, 1.f);

@@ -38,6 +38,9 @@ Image read_image(const std::string& path);
 void require_finite_pixels(const Image& img, const std::string& path);
 /// The whole file as bytes; throws SceneError(path, "", "cannot open file") if it cannot be read.
 std::string read_file(const std::string& path);
+/// The file name's extension in lower case, with its dot (".exr"; "" if none): how readers and
+/// writers tell a file's kind from its name.
+std::string lower_extension(const std::string& path);
 /// Writes `contents` to path atomically (temp + rename); a write that does not complete (a full
 /// disk) throws naming `path` and leaves `path` as it was.
 void write_text_atomic(const std::string& path, const std::string& contents);

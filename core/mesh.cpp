@@ -1,6 +1,7 @@
 // TriangleMesh: transforming to world space, the one validation pass every loader ends with, and
 // the extension dispatch over the readers in core/loaders/.
 #include "core/mesh.h"
+#include "core/image_io.h"
 #include "core/error.h"
 #include <algorithm>
 #include <cctype>
@@ -121,8 +122,7 @@ void compute_vertex_normals(TriangleMesh& mesh) {
 }
 
 TriangleMesh load_mesh_file(const std::string& path, bool flip_v, bool drop_degenerate) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    const std::string ext = lower_extension(path);
     // flip_v is an OBJ convention (Mitsuba's flip_tex_coords); PLY and glTF uvs are taken as stored.
     if (ext == ".obj") return load_obj(path, flip_v, drop_degenerate);
     if (ext == ".ply") return load_ply(path);

@@ -21,8 +21,7 @@ float display_value(float v, const std::string& tone) {
 }
 
 bool float_image_path(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const std::string ext = lower_extension(path);
     return ext == ".exr" || ext == ".hdr";
 }
 

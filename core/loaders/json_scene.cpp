@@ -2,6 +2,7 @@
 // field, e.g. `scene.json: field 'shapes[2].material': unknown material 'whte'`.
 #include "core/bsdf.h"
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/json_keys.h"
 #include "core/scene_loader.h"
 #include "core/shape_factory.h"
@@ -439,8 +440,7 @@ Scene load_scene_json(const std::string& path, const std::map<std::string, std::
 
 namespace {
 Scene load_scene_by_extension(const std::string& path, const std::map<std::string, std::string>& defines) {
-    std::string ext = fs::path(path).extension().string();
-    for (auto& ch : ext) ch = char(std::tolower(ch));
+    const std::string ext = lower_extension(path);
     if (ext == ".json") return load_scene_json(path, defines);
     if (ext == ".xml") return load_scene_mitsuba_xml(path, defines);
     throw SceneError(path, "", "unknown scene format '" + ext + "' (known: .json, .xml)");
