@@ -32,12 +32,8 @@ int run_render(const RenderArgs& a) {
         const int w = opt.width > 0 ? opt.width : scene.camera.width,
                   h = opt.height > 0 ? opt.height : scene.camera.height;
         const char* flag = a.res.empty() ? "the scene's camera" : "--res";
-        try {
-            check_image_fits(w, h, 2 * 3 + 1);  // the film's floats a pixel
-        } catch (const std::length_error& e) {
-            throw std::invalid_argument(std::string(flag) + ": " + e.what());
-        }
-        if (w > kPngMaxSide || h > kPngMaxSide)  // libpng's limit: the EXR would be written, its preview not
+        pipeline::check_size_fits(w, h, 2 * 3 + 1, flag);  // the film's floats a pixel
+        if (w > kPngMaxSide || h > kPngMaxSide)            // libpng's limit: the EXR would be written, its preview not
             throw std::invalid_argument(std::string(flag) + ": " + std::to_string(w) + "x" + std::to_string(h) +
                                         " is beyond the PNG preview's " + std::to_string(kPngMaxSide) +
                                         " pixels a side");
@@ -46,11 +42,7 @@ int run_render(const RenderArgs& a) {
     int aw = opt.width, ah = opt.height;
     if (a.aov && !a.aov_res.empty()) {
         parse_resolution(a.aov_res, aw, ah, "--aov-res");
-        try {
-            check_image_fits(aw, ah, 7);  // normal, distance, albedo
-        } catch (const std::length_error& e) {
-            throw std::invalid_argument(std::string("--aov-res: ") + e.what());
-        }
+        pipeline::check_size_fits(aw, ah, 7, "--aov-res");  // normal, distance, albedo
     }
     opt.strategy = a.strategy == "nee"    ? LightStrategy::Nee
                    : a.strategy == "bsdf" ? LightStrategy::Bsdf

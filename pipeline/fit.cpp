@@ -1,6 +1,5 @@
 #include "pipeline/fit.h"
 #include "autodiff/loss.h"
-#include "core/film.h"
 #include "core/image_io.h"
 #include "core/latent_viz.h"
 #include "core/scene_loader.h"
@@ -174,11 +173,8 @@ void validate(const FitJob& job) {
     if (job.out.empty()) throw std::invalid_argument("fit --out: the output folder is empty");
     if (fs::exists(job.out) && !fs::is_directory(job.out))
         throw std::invalid_argument("fit --out " + job.out + ": a file, not a folder");
-    if (job.terms.empty() || job.terms.find_first_not_of("eac") != std::string::npos)
-        throw std::invalid_argument("--terms takes letters from e, a, c; got '" + job.terms + "'");
+    check_terms(job.gate, job.terms, "--");
     parameterisation_from_string(job.param);
-    if (job.gate != "shadowed" && job.gate != "visible")
-        throw std::invalid_argument("--gate is shadowed or visible, got '" + job.gate + "'");
     if (job.ref_tone != "clip" && job.ref_tone != "reinhard")
         throw std::invalid_argument("--ref-tone is clip or reinhard, got '" + job.ref_tone + "'");
     // the CLI's own checks, here too for callers without it (latentpt.fit in Python)
@@ -210,11 +206,8 @@ void validate(const FitJob& job) {
     if (job.target.empty()) {
         const char* flag = job.encode ? "--encode-res" : "--synthetic-res";
         parse_resolution(job.encode ? job.encode_res : job.synthetic_res, w, h, flag);
-        try {  // the latents' renders and adjoint (synthetic), or the RGB reference (encode)
-            check_image_fits(w, h, job.encode ? 3 : 2 * kLatentChannels + 1);
-        } catch (const std::length_error& e) {
-            throw std::invalid_argument(std::string(flag) + ": " + e.what());
-        }
+        // the latents' renders and adjoint (synthetic), or the RGB reference (encode)
+        check_size_fits(w, h, job.encode ? 3 : 2 * kLatentChannels + 1, flag);
     }
     if (job.refiner) validate(job.refine);
 }

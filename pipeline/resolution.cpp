@@ -1,4 +1,5 @@
 #include "pipeline/resolution.h"
+#include "core/film.h"
 #include <algorithm>
 #include <charconv>
 #include <stdexcept>
@@ -30,6 +31,14 @@ void parse_resolution(const std::string& text, int& w, int& h, const std::string
         throw std::invalid_argument(option + " expects WxH with positive integers, got '" + text + "'");
     w = (*v)[0];
     h = (*v)[1];
+}
+
+void check_size_fits(int w, int h, size_t floats_per_pixel, const std::string& option) {
+    try {
+        check_image_fits(w, h, floats_per_pixel);
+    } catch (const std::length_error& e) {
+        throw std::invalid_argument(option + ": " + e.what());
+    }
 }
 
 }  // namespace lpt::pipeline
