@@ -48,12 +48,15 @@ std::vector<float> interleave_terms(const std::vector<float>& e, const std::vect
     return out;
 }
 
-void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {
-    // Unchecked, "xyz" rendered zeros and "visble" meant shadowed (Python's LatentScene).
+void check_terms(const std::string& gate, const std::string& terms, const std::string& prefix) {
     if (terms.empty() || terms.find_first_not_of("eac") != std::string::npos)
-        throw std::invalid_argument("terms take letters from e, a, c; got '" + terms + "'");
+        throw std::invalid_argument(prefix + "terms take letters from e, a, c; got '" + terms + "'");
     if (gate != "shadowed" && gate != "visible")
-        throw std::invalid_argument("gate is shadowed or visible, got '" + gate + "'");
+        throw std::invalid_argument(prefix + "gate is shadowed or visible, got '" + gate + "'");
+}
+
+void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms) {
+    check_terms(gate, terms);
     LatentTerms<kLatentChannels>& t = model.terms();
     t.gate = gate == "visible" ? OcclusionGate::Visible : OcclusionGate::Shadowed;
     t.emission = terms.find('e') != std::string::npos;

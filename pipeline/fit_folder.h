@@ -61,7 +61,12 @@ FitRender render_fit_terms(const FitFolder& fit, int w, int h, int spp, uint64_t
 std::vector<float> interleave_terms(const std::vector<float>& e, const std::vector<float>& a,
                                     const std::vector<float>& c, int channels);
 
-/// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac").
+/// Throws std::invalid_argument unless `gate` is "shadowed" or "visible" and `terms` letters of
+/// "eac"; `prefix` goes before the names in the message ("--" where they are flags).
+void check_terms(const std::string& gate, const std::string& terms, const std::string& prefix = "");
+
+/// Sets the model's Ĩc gate ("shadowed" | "visible") and rendered terms (letters of "eac");
+/// check_terms refuses others (unchecked, "xyz" rendered zeros and "visble" meant shadowed).
 void configure_terms(LatentModel& model, const std::string& gate, const std::string& terms);
 
 /// What makes a fit's model what it is (scene, defines, parameterisation, gate, terms, tone,
