@@ -9,11 +9,16 @@ namespace lpt::python {
 
 namespace {
 
-RenderOptions options_for(const Scene& scene, int spp, int width, int height, uint64_t seed, int max_depth) {
-    if (spp < 0) throw py::value_error("spp must be > 0, or 0 for the scene's own; got " + std::to_string(spp));
+/// Negative sizes rendered the scene's size without a word.
+void require_size(int width, int height) {
     if (width < 0 || height < 0)
         throw py::value_error("width and height must be >= 0 (0: the scene's), got " + std::to_string(width) + "x" +
                               std::to_string(height));
+}
+
+RenderOptions options_for(const Scene& scene, int spp, int width, int height, uint64_t seed, int max_depth) {
+    if (spp < 0) throw py::value_error("spp must be > 0, or 0 for the scene's own; got " + std::to_string(spp));
+    require_size(width, height);
     if (max_depth < -2)  // -1 unbounded as in scene files, -2 the scene's
         throw py::value_error("max_depth must be >= -1 (-1: unbounded), got " + std::to_string(max_depth));
     RenderOptions o = RenderOptions::from_scene(scene);
@@ -38,9 +43,7 @@ py::array_t<float> render_rgb(const Scene& scene, int spp, int width, int height
 
 py::dict render_aov_images(const Scene& scene, int width, int height, int spp, uint64_t seed) {
     if (spp <= 0) throw py::value_error("spp must be > 0, got " + std::to_string(spp));
-    if (width < 0 || height < 0)
-        throw py::value_error("width and height must be >= 0 (0: the scene's), got " + std::to_string(width) + "x" +
-                              std::to_string(height));
+    require_size(width, height);
     AovImages a;
     {
         py::gil_scoped_release unlocked;
