@@ -1,0 +1,119 @@
+#!/usr/bin/env python3
+"""How a latent follows a change of light (issue 16, docs/results.md "The latent of black as the
+renderer's zero").
+
+    python3 scripts/light_response.py black ../shared/scenes/cbox/cbox_specular.xml
+    python3 scripts/light_response.py slope results-paper/cbox-specular/light_eac [--rendered]
+
+`black`: renders the scene in RGB, encodes it and k·(the render) for a few k with the VAE, and
+regresses two predictions of the latent's change E(k·I) − E(I) on the true one: the latent scaled
+about 0 (what the latent renderer's T(k·Ĩ) = k^γ·T(Ĩ) does) and scaled about the latent of black
+E(0). Prints both slopes (1: the prediction moves as the encoder does) and the RMS of E(0) and
+E(I).
+
+`slope`: for an edit folder of `render --edit` (frames 0, 20, 40 with their references), the
+change of the decoded frame from frame 0 to frame k, averaged over 64-pixel blocks of the linear
+RGB channels, regressed on the references' change. --rendered reads the rendered latent's picture
+(frame_XXXX_rendered.png) where the folder has a refiner; by default frame_XXXX.png.
+
+Needs the Python module on PYTHONPATH for `black` (build/python), oiiotool for `slope`.
+"""
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+GAMMA = 1 / 2.2  # the tone curve's exponent (docs/fitting.md (2))
+
+
+def srgb(x):
+    x = np.clip(x, 0, 1)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055).astype(np.float32)
+
+
+def regression_slope(predicted, true):
+    """Least-squares slope of `predicted` on `true` through the origin."""
+    p, t = predicted.ravel(), true.ravel()
+    return float(p @ t / (t @ t))
+
+
+def black(args):
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "python"))
+    import latentpt
+
+    scene = latentpt.Scene(args.scene)
+    rgb = scene.render(spp=args.spp, width=args.res, height=args.res, seed=1)
+    vae = latentpt.Vae(args.vae_dir)
+    z = vae.encode(srgb(rgb))
+    z_black = vae.encode(np.zeros_like(rgb))
+    rms = lambda a: float(np.sqrt((a ** 2).mean()))  # noqa: E731
+    print(f"RMS of the latent of black {rms(z_black):.3f}, of the scene's latent {rms(z):.3f}")
+    for k in args.k:
+        change = vae.encode(srgb(k * rgb)) - z
+        scale = k ** GAMMA - 1
+        about_zero = regression_slope(scale * z, change)
+        about_black = regression_slope(scale * (z - z_black), change)
+        print(f"k = {k:g}: slope scaled about 0 {about_zero:+.3f}, about the latent of black {about_black:+.3f}")
+
+
+def read_linear_rgb(path, scratch):
+    """A PNG's display values as linear RGB (oiiotool writes a binary PPM that NumPy reads)."""
+    subprocess.run(["oiiotool", path, "-o", scratch], check=True)
+    with open(scratch, "rb") as f:
+        magic, size, _maxval, data = f.read().split(b"\n", 3)
+    if magic != b"P6":
+        sys.exit(f"{path}: oiiotool did not write a binary PPM")
+    w, h = map(int, size.split())
+    a = np.frombuffer(data, np.uint8).reshape(h, w, 3).astype(np.float64) / 255
+    return np.where(a <= 0.04045, a / 12.92, ((a + 0.055) / 1.055) ** 2.4)
+
+
+def block_means(a, side=64):
+    h, w = a.shape[0] // side * side, a.shape[1] // side * side
+    return a[:h, :w].reshape(h // side, side, w // side, side, 3).mean(axis=(1, 3))
+
+
+def slope(args):
+    suffix = "_rendered" if args.rendered else ""
+    with tempfile.TemporaryDirectory() as tmp:
+        scratch = os.path.join(tmp, "frame.ppm")
+
+        def frame(i, kind):
+            path = os.path.join(args.folder, f"frame_{i:04d}{kind}.png")
+            if not os.path.exists(path):
+                sys.exit(f"{path}: missing (an edit folder with frames 0, 20, 40 and their references?)")
+            return block_means(read_linear_rgb(path, scratch))
+
+        ref0, out0 = frame(0, "_reference"), frame(0, suffix)
+        for i in args.frames:
+            s = regression_slope(frame(i, suffix) - out0, frame(i, "_reference") - ref0)
+            print(f"{args.folder} frame {i}: slope {s:.3f}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="what", required=True)
+    b = sub.add_parser("black", help="the latent's change under a brighter light, against two predictions")
+    b.add_argument("scene")
+    b.add_argument("--res", type=int, default=256, help="image side (default 256)")
+    b.add_argument("--spp", type=int, default=256)
+    b.add_argument("--k", type=float, nargs="+", default=[0.5, 0.8, 1.25, 2.0], help="light scales")
+    b.add_argument("--vae-dir", default=os.path.join("..", "shared", "models", "taesd3"))
+    s = sub.add_parser("slope", help="how far an edit folder's frames follow the references")
+    s.add_argument("folder")
+    s.add_argument("--rendered", action="store_true", help="the rendered latent's picture, not the refined one")
+    s.add_argument("--frames", type=int, nargs="+", default=[20, 40])
+    args = ap.parse_args()
+    if args.what == "black":
+        if args.res <= 0 or args.res % 8 or args.spp <= 0 or any(k <= 0 for k in args.k):
+            ap.error("--res must be a positive multiple of 8, --spp and every --k positive")
+        black(args)
+    else:
+        slope(args)
+
+
+if __name__ == "__main__":
+    main()
