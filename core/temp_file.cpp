@@ -12,16 +12,23 @@ namespace {
 // Fixed storage: the handler may only touch memory that no allocation moves, and lock-free atomics.
 constexpr int kSlots = 64;
 constexpr size_t kPathBytes = 4096;
+/// A slot's life: Free → Writing (taken, its path being copied) → Ready (the handler may unlink
+/// it) → Free when its TemporaryFile ends. The handler moves Ready → Removing before it reads the
+/// path, and nothing moves a slot out of Removing: another thread can then neither release the
+/// slot nor take it and copy a new path over the one unlink is reading (the process is ending).
+enum SlotState : int { Free, Writing, Ready, Removing };
 struct Slot {
-    std::atomic<bool> used{false};   ///< taken by a TemporaryFile (its path being written)
-    std::atomic<bool> ready{false};  ///< path holds the whole name: the handler may unlink it
+    std::atomic<int> state{Free};
     char path[kPathBytes] = {};
 };
 Slot g_slots[kSlots];
 
 extern "C" void remove_temporaries_and_reraise(int sig) {
-    for (Slot& s : g_slots)
-        if (s.ready.load(std::memory_order_acquire)) ::unlink(s.path);  // async-signal-safe
+    for (Slot& s : g_slots) {
+        int ready = Ready;
+        if (s.state.compare_exchange_strong(ready, Removing, std::memory_order_acquire))
+            ::unlink(s.path);  // async-signal-safe
+    }
     std::signal(sig, SIG_DFL);
     std::raise(sig);  // pending until this handler returns, then the default action
 }
@@ -29,13 +36,13 @@ extern "C" void remove_temporaries_and_reraise(int sig) {
 }  // namespace
 
 TemporaryFile::TemporaryFile(const std::string& path) {
-    static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler reads these");
+    static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads these");
     if (path.size() >= kPathBytes) return;
     for (int i = 0; i < kSlots; ++i) {
-        bool expected = false;
-        if (!g_slots[i].used.compare_exchange_strong(expected, true)) continue;
+        int expected = Free;
+        if (!g_slots[i].state.compare_exchange_strong(expected, Writing, std::memory_order_acquire)) continue;
         std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
-        g_slots[i].ready.store(true, std::memory_order_release);
+        g_slots[i].state.store(Ready, std::memory_order_release);
         m_slot = i;
         return;
     }
@@ -43,8 +50,9 @@ TemporaryFile::TemporaryFile(const std::string& path) {
 
 TemporaryFile::~TemporaryFile() {
     if (m_slot < 0) return;
-    g_slots[m_slot].ready.store(false, std::memory_order_release);
-    g_slots[m_slot].used.store(false, std::memory_order_release);
+    // Fails only while the handler is removing the file: the slot then stays out of use.
+    int ready = Ready;
+    g_slots[m_slot].state.compare_exchange_strong(ready, Free, std::memory_order_release);
 }
 
 void remove_temporaries_on_interrupt() {
