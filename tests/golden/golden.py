@@ -9,10 +9,16 @@ compares the hashes with the stored ones. `--update` stores the current hashes i
 on the commit whose outputs define the reference, and say so in that commit.
 
 Floating-point results depend on the CPU's instruction set (Embree and libtorch pick their kernels at
-run time), so the stored hashes hold for the machine that wrote them: the CI machine. The manifest
-records that machine's CPU model and the vector extensions the kernels choose between; on another
-CPU the test reports the mismatch as a skip (exit 77), not a failure. The model string alone is not
-enough: two machines that both call themselves "AMD EPYC" wrote different plain renders.
+run time), so hashes hold for the kind of machine that wrote them. The manifest keeps one set per
+kind, named by its CPU model and the vector extensions the kernels choose between (the model string
+alone is not enough: two machines that both call themselves "AMD EPYC" wrote different plain
+renders). A machine compares its outputs with its own kind's set; a kind with no set reports a skip
+(exit 77), not a failure.
+
+    --update        the outputs changed on purpose: this machine's hashes become the only set (the
+                    other kinds' no longer describe the outputs; say so in the commit)
+    --add-machine   the outputs did not change since the stored sets were written: this machine's
+                    hashes join them (or replace its kind's own)
 """
 import argparse
 import csv
@@ -60,6 +66,32 @@ def cpu_isa():
         return "unknown"
     have = set(flags.split())
     return " ".join(flag for flag in DISPATCH_FLAGS if flag in have)
+
+
+def this_machine():
+    return cpu_model(), cpu_isa()
+
+
+def stored_sets():
+    """The manifest's hash sets, one per machine kind (a manifest from before 2026-12-08 held one)."""
+    if not os.path.exists(MANIFEST):
+        return []
+    with open(MANIFEST) as f:
+        doc = json.load(f)
+    return doc["machines"] if "machines" in doc else [doc]
+
+
+def write_manifest(sets):
+    tmp_path = MANIFEST + ".tmp"
+    with open(tmp_path, "w") as f:
+        json.dump({"machines": sets}, f, indent=1, sort_keys=True)
+        f.write("\n")
+    os.replace(tmp_path, MANIFEST)
+
+
+def source_commit(src):
+    r = subprocess.run(["git", "-C", src, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    return r.stdout.strip() if r.returncode == 0 else "unknown"
 
 
 def commands(b, src, shared, out):
@@ -151,7 +183,11 @@ def main():
     ap.add_argument("--src", default=os.path.dirname(os.path.dirname(HERE)), help="source tree")
     ap.add_argument("--shared", default=None, help="shared data (default: LATENTPT_SHARED or ../shared)")
     ap.add_argument("--out", default=None, help="keep the outputs here (default: a temporary folder)")
-    ap.add_argument("--update", action="store_true", help="store the current hashes as the reference")
+    what = ap.add_mutually_exclusive_group()
+    what.add_argument("--update", action="store_true",
+                      help="the outputs changed on purpose: store this machine's hashes as the only set")
+    what.add_argument("--add-machine", action="store_true",
+                      help="the outputs are unchanged: add this machine's hashes beside the stored sets")
     args = ap.parse_args()
     shared = args.shared or os.environ.get("LATENTPT_SHARED") or os.path.join(args.src, "..", "shared")
 
@@ -166,18 +202,21 @@ def main():
             folder = os.path.join(out, name)
             current[name] = hash_outputs(folder)
 
-    if args.update:
-        doc = {"cpu": cpu_model(), "isa": cpu_isa(), "runs": current}
-        tmp_path = MANIFEST + ".tmp"
-        with open(tmp_path, "w") as f:
-            json.dump(doc, f, indent=1, sort_keys=True)
-            f.write("\n")
-        os.replace(tmp_path, MANIFEST)
-        print(f"stored {sum(len(v) for v in current.values())} hashes from {len(current)} runs in {MANIFEST}")
+    sets = stored_sets()
+    if args.update or args.add_machine:
+        kept = [m for m in sets if args.add_machine and (m["cpu"], m["isa"]) != this_machine()]
+        write_manifest(kept + [{"cpu": cpu_model(), "isa": cpu_isa(), "commit": source_commit(args.src),
+                                "runs": current}])
+        print(f"stored {sum(len(v) for v in current.values())} hashes from {len(current)} runs for this machine "
+              f"in {MANIFEST} ({len(kept)} other machine kinds kept)")
         return 0
 
-    with open(MANIFEST) as f:
-        stored = json.load(f)
+    mine = [m for m in sets if (m["cpu"], m["isa"]) == this_machine()]
+    if not mine:
+        kinds = "; ".join(f"'{m['cpu']}' ({m['isa']})" for m in sets)
+        print(f"no hashes stored for this machine, '{cpu_model()}' ({cpu_isa()}); stored for: {kinds}: skipped")
+        return 77
+    stored = mine[0]
     differ, missing = [], []
     for name, files in stored["runs"].items():
         if name not in current:
@@ -192,13 +231,10 @@ def main():
     if missing:
         print(f"not run (no ../shared data?): {', '.join(missing)}")
     if differ:
-        print(f"{len(differ)} of {checked} outputs differ from the stored ones:\n  " + "\n  ".join(differ))
-        stored_on, this = (stored.get("cpu"), stored.get("isa")), (cpu_model(), cpu_isa())
-        if stored_on != this:
-            print(f"stored on '{stored_on[0]}' ({stored_on[1]}), this is '{this[0]}' ({this[1]}): skipped")
-            return 77
+        print(f"{len(differ)} of {checked} outputs differ from the ones stored for this machine "
+              f"(at {stored.get('commit', 'an unrecorded commit')}):\n  " + "\n  ".join(differ))
         return 1
-    print(f"{checked} outputs bit-identical to the stored ones ({len(current)} runs)")
+    print(f"{checked} outputs bit-identical to the ones stored for this machine ({len(current)} runs)")
     return 0
 
 
