@@ -25,8 +25,10 @@ Slot g_slots[kSlots];
 
 extern "C" void remove_temporaries_and_reraise(int sig) {
     for (Slot& s : g_slots) {
-        int ready = Ready;
-        if (s.state.compare_exchange_strong(ready, Removing, std::memory_order_acquire))
+        // A slot another handler already claimed is unlinked here too: that handler may not
+        // have reached it when this one ends the process. Its path no longer changes.
+        int state = Ready;
+        if (s.state.compare_exchange_strong(state, Removing, std::memory_order_acquire) || state == Removing)
             ::unlink(s.path);  // async-signal-safe
     }
     std::signal(sig, SIG_DFL);
@@ -63,6 +65,7 @@ void remove_temporaries_on_interrupt() {
         struct sigaction act {};
         act.sa_handler = remove_temporaries_and_reraise;
         sigemptyset(&act.sa_mask);
+        for (int other : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&act.sa_mask, other);  // no nesting
         act.sa_flags = SA_RESTART;
         ::sigaction(sig, &act, nullptr);
     }
