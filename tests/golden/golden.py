@@ -18,7 +18,7 @@ renders). A machine compares its outputs with its own kind's set; a kind with no
     --update        the outputs changed on purpose: this machine's hashes become the only set (the
                     other kinds' no longer describe the outputs; say so in the commit)
     --add-machine   the outputs did not change since the stored sets were written: this machine's
-                    hashes join them (or replace its kind's own)
+                    hashes join them (refused where its kind's own set holds other hashes)
 """
 import argparse
 import csv
@@ -90,7 +90,9 @@ def write_manifest(sets):
 
 
 def source_commit(src):
-    r = subprocess.run(["git", "-C", src, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
+    """The commit whose outputs these are, "-dirty" when the tree has changes beyond it."""
+    r = subprocess.run(["git", "-C", src, "describe", "--always", "--dirty", "--abbrev=7", "--exclude=*"],
+                       capture_output=True, text=True)
     return r.stdout.strip() if r.returncode == 0 else "unknown"
 
 
@@ -203,7 +205,24 @@ def main():
             current[name] = hash_outputs(folder)
 
     sets = stored_sets()
+    if not sets and not args.update:
+        print(f"{MANIFEST}: missing or empty; golden.py --update stores the hashes", file=sys.stderr)
+        return 1
+    mine = [m for m in sets if (m["cpu"], m["isa"]) == this_machine()]
     if args.update or args.add_machine:
+        stored_runs = {name for m in sets for name in m["runs"]} if args.add_machine else set()
+        not_run = sorted(stored_runs - current.keys()) or ([] if os.path.isdir(shared) else [shared])
+        if not_run:
+            print(f"not run here (no ../shared data?): {', '.join(not_run)}; a set without them checks less: "
+                  "nothing stored", file=sys.stderr)
+            return 1
+        if args.add_machine and mine:
+            if mine[0]["runs"] == current:
+                print(f"this machine's hashes are stored already (at {mine[0].get('commit')}), and match")
+                return 0
+            print("this machine's outputs differ from the hashes already stored for it: if they changed on purpose, "
+                  "use --update", file=sys.stderr)
+            return 1
         kept = [m for m in sets if args.add_machine and (m["cpu"], m["isa"]) != this_machine()]
         write_manifest(kept + [{"cpu": cpu_model(), "isa": cpu_isa(), "commit": source_commit(args.src),
                                 "runs": current}])
@@ -211,7 +230,6 @@ def main():
               f"in {MANIFEST} ({len(kept)} other machine kinds kept)")
         return 0
 
-    mine = [m for m in sets if (m["cpu"], m["isa"]) == this_machine()]
     if not mine:
         kinds = "; ".join(f"'{m['cpu']}' ({m['isa']})" for m in sets)
         print(f"no hashes stored for this machine, '{cpu_model()}' ({cpu_isa()}); stored for: {kinds}: skipped")
@@ -227,6 +245,7 @@ def main():
                 differ.append(f"{name}/{rel}")
         for rel in current[name].keys() - files.keys():
             differ.append(f"{name}/{rel} (new output)")
+    differ += [f"{name}/ (new run)" for name in sorted(current.keys() - stored["runs"].keys())]
     checked = sum(len(current.get(n, {})) for n in stored["runs"])
     if missing:
         print(f"not run (no ../shared data?): {', '.join(missing)}")
