@@ -16,7 +16,9 @@ change of the decoded frame from frame 0 to frame k, averaged over 64-pixel bloc
 RGB channels, regressed on the references' change. --rendered reads the rendered latent's picture
 (frame_XXXX_rendered.png) where the folder has a refiner; by default frame_XXXX.png.
 
-Needs the Python module on PYTHONPATH for `black` (build/python), oiiotool for `slope`.
+Display values are linear RGB clipped to [0, 1] to the power 1/2.2, as the fit's references and
+the pictures of `render --edit` (pipeline/reference.cpp display_value). Needs NumPy, the Python
+module (build/python) for `black`, oiiotool for `slope`.
 """
 import argparse
 import os
@@ -24,55 +26,69 @@ import subprocess
 import sys
 import tempfile
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError:
+    sys.exit("light_response.py needs NumPy (python3-numpy; scripts/install-deps.sh installs it)")
 
-GAMMA = 1 / 2.2  # the tone curve's exponent (docs/fitting.md (2))
-
-
-def srgb(x):
-    x = np.clip(x, 0, 1)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055).astype(np.float32)
+GAMMA = 1 / 2.2  # the display mapping's exponent, and the tone curve's (docs/fitting.md (2))
 
 
-def regression_slope(predicted, true):
+def display(linear):
+    return (np.clip(linear, 0, 1) ** GAMMA).astype(np.float32)
+
+
+def regression_slope(predicted, true, what):
     """Least-squares slope of `predicted` on `true` through the origin."""
     p, t = predicted.ravel(), true.ravel()
+    if not t @ t > 0:
+        sys.exit(f"{what}: the true change is zero, so no slope can be measured")
     return float(p @ t / (t @ t))
 
 
 def black(args):
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "python"))
-    import latentpt
-
-    scene = latentpt.Scene(args.scene)
-    rgb = scene.render(spp=args.spp, width=args.res, height=args.res, seed=1)
-    vae = latentpt.Vae(args.vae_dir)
-    z = vae.encode(srgb(rgb))
+    try:
+        import latentpt
+    except ImportError as e:
+        sys.exit(f"light_response.py black needs the latentpt module (bash scripts/build.sh): {e}")
+    try:
+        rgb = latentpt.Scene(args.scene).render(spp=args.spp, width=args.res, height=args.res, seed=1)
+        vae = latentpt.Vae(args.vae_dir)
+    except (ValueError, RuntimeError) as e:
+        sys.exit(str(e))
+    z = vae.encode(display(rgb))
     z_black = vae.encode(np.zeros_like(rgb))
     rms = lambda a: float(np.sqrt((a ** 2).mean()))  # noqa: E731
     print(f"RMS of the latent of black {rms(z_black):.3f}, of the scene's latent {rms(z):.3f}")
     for k in args.k:
-        change = vae.encode(srgb(k * rgb)) - z
+        change = vae.encode(display(k * rgb)) - z
         scale = k ** GAMMA - 1
-        about_zero = regression_slope(scale * z, change)
-        about_black = regression_slope(scale * (z - z_black), change)
+        about_zero = regression_slope(scale * z, change, f"k = {k:g}")
+        about_black = regression_slope(scale * (z - z_black), change, f"k = {k:g}")
         print(f"k = {k:g}: slope scaled about 0 {about_zero:+.3f}, about the latent of black {about_black:+.3f}")
 
 
 def read_linear_rgb(path, scratch):
     """A PNG's display values as linear RGB (oiiotool writes a binary PPM that NumPy reads)."""
-    subprocess.run(["oiiotool", path, "-o", scratch], check=True)
+    try:
+        r = subprocess.run(["oiiotool", path, "-o", scratch], capture_output=True, text=True)
+    except FileNotFoundError:
+        sys.exit("light_response.py slope needs oiiotool (openimageio-tools)")
+    if r.returncode != 0:
+        sys.exit(f"{path}: oiiotool could not read it: {r.stderr.strip()}")
     with open(scratch, "rb") as f:
-        magic, size, _maxval, data = f.read().split(b"\n", 3)
-    if magic != b"P6":
-        sys.exit(f"{path}: oiiotool did not write a binary PPM")
+        magic, size, maxval, data = f.read().split(b"\n", 3)
+    if magic != b"P6" or maxval != b"255":
+        sys.exit(f"{path}: oiiotool did not write an 8-bit binary PPM")
     w, h = map(int, size.split())
-    a = np.frombuffer(data, np.uint8).reshape(h, w, 3).astype(np.float64) / 255
-    return np.where(a <= 0.04045, a / 12.92, ((a + 0.055) / 1.055) ** 2.4)
+    return (np.frombuffer(data, np.uint8).reshape(h, w, 3).astype(np.float64) / 255) ** 2.2
 
 
-def block_means(a, side=64):
+def block_means(a, path, side=64):
     h, w = a.shape[0] // side * side, a.shape[1] // side * side
+    if h == 0 or w == 0:
+        sys.exit(f"{path}: {a.shape[1]}x{a.shape[0]} pixels, smaller than one {side}-pixel block")
     return a[:h, :w].reshape(h // side, side, w // side, side, 3).mean(axis=(1, 3))
 
 
@@ -85,11 +101,16 @@ def slope(args):
             path = os.path.join(args.folder, f"frame_{i:04d}{kind}.png")
             if not os.path.exists(path):
                 sys.exit(f"{path}: missing (an edit folder with frames 0, 20, 40 and their references?)")
-            return block_means(read_linear_rgb(path, scratch))
+            return block_means(read_linear_rgb(path, scratch), path)
 
         ref0, out0 = frame(0, "_reference"), frame(0, suffix)
+        if ref0.shape != out0.shape:
+            sys.exit(f"{args.folder}: frame 0 and its reference differ in size")
         for i in args.frames:
-            s = regression_slope(frame(i, suffix) - out0, frame(i, "_reference") - ref0)
+            ref, out = frame(i, "_reference"), frame(i, suffix)
+            if ref.shape != ref0.shape or out.shape != out0.shape:
+                sys.exit(f"{args.folder}: frame {i} differs in size from frame 0")
+            s = regression_slope(out - out0, ref - ref0, f"{args.folder} frame {i}")
             print(f"{args.folder} frame {i}: slope {s:.3f}")
 
 
@@ -101,15 +122,15 @@ def main():
     b.add_argument("--res", type=int, default=256, help="image side (default 256)")
     b.add_argument("--spp", type=int, default=256)
     b.add_argument("--k", type=float, nargs="+", default=[0.5, 0.8, 1.25, 2.0], help="light scales")
-    b.add_argument("--vae-dir", default=os.path.join("..", "shared", "models", "taesd3"))
+    b.add_argument("--vae-dir", default="", help="TAESD3 weights (default: the module's, ../shared/models/taesd3)")
     s = sub.add_parser("slope", help="how far an edit folder's frames follow the references")
     s.add_argument("folder")
     s.add_argument("--rendered", action="store_true", help="the rendered latent's picture, not the refined one")
     s.add_argument("--frames", type=int, nargs="+", default=[20, 40])
     args = ap.parse_args()
     if args.what == "black":
-        if args.res <= 0 or args.res % 8 or args.spp <= 0 or any(k <= 0 for k in args.k):
-            ap.error("--res must be a positive multiple of 8, --spp and every --k positive")
+        if args.res <= 0 or args.res % 8 or args.spp <= 0 or any(k <= 0 or k == 1 for k in args.k):
+            ap.error("--res must be a positive multiple of 8, --spp positive, every --k positive and not 1")
         black(args)
     else:
         slope(args)
