@@ -4,6 +4,7 @@ renderer's zero").
 
     python3 scripts/light_response.py black ../shared/scenes/cbox/cbox_specular.xml
     python3 scripts/light_response.py slope results-paper/cbox-specular/light_eac [--rendered]
+    python3 scripts/light_response.py exposure results-paper/cbox-specular/fit_eac
 
 `black`: renders the scene in RGB, encodes it and k·(the render) for a few k with the VAE, and
 regresses two predictions of the latent's change E(k·I) − E(I) on the true one: the latent scaled
@@ -16,11 +17,17 @@ change of the decoded frame from frame 0 to frame k, averaged over 64-pixel bloc
 RGB channels, regressed on the references' change. --rendered reads the rendered latent's picture
 (frame_XXXX_rendered.png) where the folder has a refiner; by default frame_XXXX.png.
 
+`exposure`: renders a fit folder's model with every L̃e scaled by k (all its lights k times
+brighter; the same seed) and regresses the decoded change, over 64-pixel blocks of linear RGB, on
+the true one, (k − 1) times the scene's RGB render: 1 where the fitted model answers a light's
+intensity as the scene does.
+
 Display values are linear RGB clipped to [0, 1] to the power 1/2.2, as the fit's references and
 the pictures of `render --edit` (pipeline/reference.cpp display_value). Needs NumPy, the Python
 module (build/python) for `black`, oiiotool for `slope`.
 """
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -46,12 +53,17 @@ def regression_slope(predicted, true, what):
     return float(p @ t / (t @ t))
 
 
-def black(args):
+def import_latentpt():
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "build", "python"))
     try:
         import latentpt
     except ImportError as e:
-        sys.exit(f"light_response.py black needs the latentpt module (bash scripts/build.sh): {e}")
+        sys.exit(f"light_response.py needs the latentpt module (bash scripts/build.sh): {e}")
+    return latentpt
+
+
+def black(args):
+    latentpt = import_latentpt()
     try:
         rgb = latentpt.Scene(args.scene).render(spp=args.spp, width=args.res, height=args.res, seed=1)
         vae = latentpt.Vae(args.vae_dir)
@@ -69,6 +81,42 @@ def black(args):
         print(f"k = {k:g}: slope scaled about 0 {about_zero:+.3f}, about the latent of black {about_black:+.3f}")
 
 
+def exposure(args):
+    latentpt = import_latentpt()
+    try:
+        model = latentpt.LatentScene.from_fit(args.fit)
+        vae = latentpt.Vae.from_fit(args.fit)
+        with open(os.path.join(args.fit, "fit.json")) as f:
+            manifest = json.load(f)
+        w, h = manifest["latent_width"], manifest["latent_height"]
+        f = 8  # TAESD3's downsampling
+        scene = latentpt.Scene(manifest["scene"], manifest.get("defines") or {}, manifest.get("sampler") or "")
+    except (ValueError, RuntimeError, OSError, KeyError) as e:
+        sys.exit(f"{args.fit}: not a fit folder this can read: {e}")
+    truth = block_means(np.clip(scene.render(spp=args.spp, width=f * w, height=f * h, seed=1), 0, 1), args.fit)
+    emission = [s["name"] for s in model.slices() if s["kind"] == "Le"]
+    values = {name: np.array(model.value(name), np.float32) for name in emission}
+    decoded = lambda: display_inverse(vae.decode(model.render(width=w, height=h, spp=args.spp, seed=5)))  # noqa: E731
+    base = block_means(decoded(), args.fit)
+    for k in args.k:
+        try:
+            for name in emission:
+                model.set_value(name, k * values[name])
+            scaled = block_means(decoded(), args.fit)
+        except ValueError as e:
+            print(f"k = {k:g}: not rendered ({e})")
+            continue
+        finally:
+            for name in emission:
+                model.set_value(name, values[name])
+        s = regression_slope(scaled - base, (k - 1) * truth, f"k = {k:g}")
+        print(f"{args.fit} k = {k:g}: slope {s:.3f}")
+
+
+def display_inverse(display_values):
+    return np.clip(display_values, 0, 1).astype(np.float64) ** 2.2
+
+
 def read_linear_rgb(path, scratch):
     """A PNG's display values as linear RGB (oiiotool writes a binary PPM that NumPy reads)."""
     try:
@@ -82,7 +130,7 @@ def read_linear_rgb(path, scratch):
     if magic != b"P6" or maxval != b"255":
         sys.exit(f"{path}: oiiotool did not write an 8-bit binary PPM")
     w, h = map(int, size.split())
-    return (np.frombuffer(data, np.uint8).reshape(h, w, 3).astype(np.float64) / 255) ** 2.2
+    return display_inverse(np.frombuffer(data, np.uint8).reshape(h, w, 3) / 255)
 
 
 def block_means(a, path, side=64):
@@ -127,8 +175,16 @@ def main():
     s.add_argument("folder")
     s.add_argument("--rendered", action="store_true", help="the rendered latent's picture, not the refined one")
     s.add_argument("--frames", type=int, nargs="+", default=[20, 40])
+    e = sub.add_parser("exposure", help="how a fit's render answers all its lights made k times brighter")
+    e.add_argument("fit")
+    e.add_argument("--spp", type=int, default=64)
+    e.add_argument("--k", type=float, nargs="+", default=[0.8, 1.25], help="light scales")
     args = ap.parse_args()
-    if args.what == "black":
+    if args.what == "exposure":
+        if args.spp <= 0 or any(k <= 0 or k == 1 for k in args.k):
+            ap.error("--spp must be positive, every --k positive and not 1")
+        exposure(args)
+    elif args.what == "black":
         if args.res <= 0 or args.res % 8 or args.spp <= 0 or any(k <= 0 or k == 1 for k in args.k):
             ap.error("--res must be a positive multiple of 8, --spp positive, every --k positive and not 1")
         black(args)
