@@ -89,15 +89,16 @@ def exposure(args):
         with open(os.path.join(args.fit, "fit.json")) as f:
             manifest = json.load(f)
         w, h = manifest["latent_width"], manifest["latent_height"]
-        f = 8  # TAESD3's downsampling
         scene = latentpt.Scene(manifest["scene"], manifest.get("defines") or {}, manifest.get("sampler") or "")
     except (ValueError, RuntimeError, OSError, KeyError) as e:
         sys.exit(f"{args.fit}: not a fit folder this can read: {e}")
-    truth = block_means(np.clip(scene.render(spp=args.spp, width=f * w, height=f * h, seed=1), 0, 1), args.fit)
     emission = [s["name"] for s in model.slices() if s["kind"] == "Le"]
     values = {name: np.array(model.value(name), np.float32) for name in emission}
     decoded = lambda: display_inverse(vae.decode(model.render(width=w, height=h, spp=args.spp, seed=5)))  # noqa: E731
-    base = block_means(decoded(), args.fit)
+    picture = decoded()
+    base = block_means(picture, args.fit)
+    rgb = scene.render(spp=args.spp, width=picture.shape[1], height=picture.shape[0], seed=1)  # the VAE's size
+    truth = block_means(np.clip(rgb, 0, 1), args.fit)
     for k in args.k:
         try:
             for name in emission:
