@@ -6,11 +6,11 @@ renderer's zero").
     python3 scripts/light_response.py slope results-paper/cbox-specular/light_eac [--rendered]
     python3 scripts/light_response.py exposure results-paper/cbox-specular/fit_eac
 
-`black`: renders the scene in RGB, encodes it and k·(the render) for a few k with the VAE, and
-regresses two predictions of the latent's change E(k·I) − E(I) on the true one: the latent scaled
-about 0 (what the latent renderer's T(k·Ĩ) = k^γ·T(Ĩ) does) and scaled about the latent of black
-E(0). Prints both slopes (1: the prediction moves as the encoder does) and the RMS of E(0) and
-E(I).
+`black`: renders the scene in RGB, encodes its display values d and k^γ·d (a light k times brighter,
+below the clip) for a few k with the VAE, and regresses two predictions of the latent's change
+E(k^γ·d) − E(d) on the true one: the latent scaled about 0 (what the latent renderer's T(k·Ĩ) =
+k^γ·T(Ĩ) does) and scaled about the latent of black E(0). Prints both slopes (1: the prediction
+moves as the encoder does) and the RMS of E(0) and E(d).
 
 `slope`: for an edit folder of `render --edit` (frames 0, 20, 40 with their references), the
 change of the decoded frame from frame 0 to frame k, averaged over 64-pixel blocks of the linear
@@ -19,15 +19,17 @@ RGB channels, regressed on the references' change. --rendered reads the rendered
 
 `exposure`: renders a fit folder's model with every L̃e scaled by k (all its lights k times
 brighter; the same seed) and regresses the decoded change, over 64-pixel blocks of linear RGB, on
-the true one, (k − 1) times the scene's RGB render: 1 where the fitted model answers a light's
-intensity as the scene does.
+the true one, clip(k·I) − clip(I) of the scene's RGB render I: 1 where the fitted model answers a
+light's intensity as the scene does. The model's `background` slice (the void's look) is not
+scaled. Fits with --ref-tone clip only.
 
 Display values are linear RGB clipped to [0, 1] to the power 1/2.2, as the fit's references and
 the pictures of `render --edit` (pipeline/reference.cpp display_value). Needs NumPy, the Python
-module (build/python) for `black`, oiiotool for `slope`.
+module (build/python) for `black` and `exposure`, oiiotool for `slope`.
 """
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -74,7 +76,9 @@ def black(args):
     rms = lambda a: float(np.sqrt((a ** 2).mean()))  # noqa: E731
     print(f"RMS of the latent of black {rms(z_black):.3f}, of the scene's latent {rms(z):.3f}")
     for k in args.k:
-        change = vae.encode(display(k * rgb)) - z
+        # display values scaled by k^γ: a k times brighter light below the clip, and exactly what
+        # the tone curve's scaling assumes, so the regression sees the encoder alone
+        change = vae.encode(k ** GAMMA * display(rgb)) - z
         scale = k ** GAMMA - 1
         about_zero = regression_slope(scale * z, change, f"k = {k:g}")
         about_black = regression_slope(scale * (z - z_black), change, f"k = {k:g}")
@@ -89,29 +93,39 @@ def exposure(args):
         with open(os.path.join(args.fit, "fit.json")) as f:
             manifest = json.load(f)
         w, h = manifest["latent_width"], manifest["latent_height"]
-        scene = latentpt.Scene(manifest["scene"], manifest.get("defines") or {}, manifest.get("sampler") or "")
     except (ValueError, RuntimeError, OSError, KeyError) as e:
         sys.exit(f"{args.fit}: not a fit folder this can read: {e}")
+    if manifest.get("ref_tone", "clip") != "clip":
+        sys.exit(f"{args.fit}: fitted with --ref-tone {manifest['ref_tone']}; exposure compares clipped linear RGB")
     emission = [s["name"] for s in model.slices() if s["kind"] == "Le"]
-    values = {name: np.array(model.value(name), np.float32) for name in emission}
-    decoded = lambda: display_inverse(vae.decode(model.render(width=w, height=h, spp=args.spp, seed=5)))  # noqa: E731
+    if not emission:
+        sys.exit(f"{args.fit}: the model has no L̃e slice to scale")
+    values, raw = {name: np.array(model.value(name), np.float32) for name in emission}, model.raw
+
+    def decoded():
+        return display_inverse(vae.decode(model.render(width=w, height=h, spp=args.spp, seed=5)))
+
     picture = decoded()
     base = block_means(picture, args.fit)
-    rgb = scene.render(spp=args.spp, width=picture.shape[1], height=picture.shape[0], seed=1)  # the VAE's size
-    truth = block_means(np.clip(rgb, 0, 1), args.fit)
+    # the fit's own scene (its defines and sampler), at the size the VAE decodes to
+    rgb = model.scene.render(spp=args.spp, width=picture.shape[1], height=picture.shape[0], seed=1)
+    measured = 0
     for k in args.k:
         try:
             for name in emission:
                 model.set_value(name, k * values[name])
             scaled = block_means(decoded(), args.fit)
         except ValueError as e:
-            print(f"k = {k:g}: not rendered ({e})")
+            print(f"k = {k:g}: not rendered ({e})", file=sys.stderr)
             continue
         finally:
-            for name in emission:
-                model.set_value(name, values[name])
-        s = regression_slope(scaled - base, (k - 1) * truth, f"k = {k:g}")
+            model.raw = raw
+        truth = block_means(np.clip(k * rgb, 0, 1), args.fit) - block_means(np.clip(rgb, 0, 1), args.fit)
+        s = regression_slope(scaled - base, truth, f"k = {k:g}")
         print(f"{args.fit} k = {k:g}: slope {s:.3f}")
+        measured += 1
+    if measured == 0:
+        sys.exit(f"{args.fit}: no k could be rendered")
 
 
 def display_inverse(display_values):
@@ -121,13 +135,14 @@ def display_inverse(display_values):
 def read_linear_rgb(path, scratch):
     """A PNG's display values as linear RGB (oiiotool writes a binary PPM that NumPy reads)."""
     try:
-        r = subprocess.run(["oiiotool", path, "-o", scratch], capture_output=True, text=True)
+        r = subprocess.run(["oiiotool", path, "-d", "uint8", "-o", scratch], capture_output=True, text=True)
     except FileNotFoundError:
         sys.exit("light_response.py slope needs oiiotool (openimageio-tools)")
     if r.returncode != 0:
         sys.exit(f"{path}: oiiotool could not read it: {r.stderr.strip()}")
     with open(scratch, "rb") as f:
-        magic, size, maxval, data = f.read().split(b"\n", 3)
+        parts = f.read().split(b"\n", 3)
+    magic, size, maxval, data = parts if len(parts) == 4 else (b"", b"", b"", b"")
     if magic != b"P6" or maxval != b"255":
         sys.exit(f"{path}: oiiotool did not write an 8-bit binary PPM")
     w, h = map(int, size.split())
@@ -181,12 +196,13 @@ def main():
     e.add_argument("--spp", type=int, default=64)
     e.add_argument("--k", type=float, nargs="+", default=[0.8, 1.25], help="light scales")
     args = ap.parse_args()
+    bad_k = any(not math.isfinite(k) or k <= 0 or k == 1 for k in getattr(args, "k", []))
     if args.what == "exposure":
-        if args.spp <= 0 or any(k <= 0 or k == 1 for k in args.k):
+        if args.spp <= 0 or bad_k:
             ap.error("--spp must be positive, every --k positive and not 1")
         exposure(args)
     elif args.what == "black":
-        if args.res <= 0 or args.res % 8 or args.spp <= 0 or any(k <= 0 or k == 1 for k in args.k):
+        if args.res <= 0 or args.res % 8 or args.spp <= 0 or bad_k:
             ap.error("--res must be a positive multiple of 8, --spp positive, every --k positive and not 1")
         black(args)
     else:
