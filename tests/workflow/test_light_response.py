@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """scripts/light_response.py slope: the regression of a folder's frame changes on its references'
 changes, on flat pictures whose linear values are known (display value d ↦ d^2.2), and its
-refusals of bad input (one message naming the file, exit 1, no traceback). ~10 s."""
+refusals of bad input (one message naming the file, exit 1, no traceback). ~20 s."""
 import os
 import shutil
 import subprocess
@@ -20,11 +20,18 @@ def flat_png(path, byte, size=128):
                     "-o", path], check=True, capture_output=True)
 
 
+def halves_png(path, left, right):
+    """A 128 × 64 PNG: two 64-pixel blocks, grey `left` and `right` (8-bit display values)."""
+    a, b = left / 255, right / 255
+    subprocess.run(["oiiotool", "--pattern", f"constant:color={a},{a},{a}", "128x64", "3",
+                    f"--fill:color={b},{b},{b}", "64x64+64+0", "-d", "uint8", "-o", path],
+                   check=True, capture_output=True)
+
+
 def run(*args):
     return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
 
 
-@unittest.skipUnless(shutil.which("oiiotool"), "oiiotool not installed")
 class Slope(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.mkdtemp(prefix="light-response-")
@@ -56,9 +63,14 @@ class Slope(unittest.TestCase):
         self.assertGreater(abs(measured - srgb), 0.05)
         self.assertGreater(abs(measured - ratio(lambda d: d)), 0.05)  # nor the display values
 
-    def test_frames_equal_to_their_references_follow_with_slope_one(self):
-        self.folder({0: 40, 20: 200}, {0: 40, 20: 200})
-        self.assertAlmostEqual(self.slope(20), 1.0, places=6)
+    def test_each_block_is_paired_with_its_own(self):
+        # the references brighten the left block more, the frame the right one: blocks paired
+        # wrongly (a transposed reshape, one mean over the picture) would give 1
+        for name, left, right in (("frame_0000_reference", 5, 5), ("frame_0020_reference", 40, 20),
+                                  ("frame_0000", 5, 5), ("frame_0020", 20, 40)):
+            halves_png(os.path.join(self.dir, name + ".png"), left, right)
+        a, b = ((40 / 255) ** 2.2 - (5 / 255) ** 2.2), ((20 / 255) ** 2.2 - (5 / 255) ** 2.2)
+        self.assertAlmostEqual(self.slope(20), 2 * a * b / (a * a + b * b), places=3)
 
     def test_bad_folders_are_refused_by_name(self):
         cases = {
@@ -76,6 +88,18 @@ class Slope(unittest.TestCase):
                 self.assertIn(message, r.stderr)
                 self.assertNotIn("Traceback", r.stderr)
 
+    def test_bad_scales_are_refused_before_any_work(self):
+        for argv in (["exposure", self.dir, "--k", "1"], ["exposure", self.dir, "--k", "nan"],
+                     ["black", "no-scene.xml", "--k", "-2"], ["black", "no-scene.xml", "--res", "100"]):
+            with self.subTest(argv):
+                r = run(*argv)
+                self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+                self.assertIn("light_response.py: error:", r.stderr)
+                self.assertNotIn("Traceback", r.stderr)
+
 
 if __name__ == "__main__":
+    if not shutil.which("oiiotool"):
+        print("oiiotool not installed: skipped")
+        sys.exit(77)
     unittest.main()
