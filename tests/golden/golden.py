@@ -73,12 +73,20 @@ def this_machine():
 
 
 def stored_sets():
-    """The manifest's hash sets, one per machine kind (a manifest from before 2026-12-08 held one)."""
+    """The manifest's hash sets, one per machine kind (a manifest from before 2026-12-08 held one);
+    [] without a manifest. Exits naming the file when it is malformed."""
     if not os.path.exists(MANIFEST):
         return []
-    with open(MANIFEST) as f:
-        doc = json.load(f)
-    return doc["machines"] if "machines" in doc else [doc]
+    try:
+        with open(MANIFEST) as f:
+            doc = json.load(f)
+        sets = doc["machines"] if "machines" in doc else [doc]
+        for m in sets:
+            if not (isinstance(m["cpu"], str) and isinstance(m["isa"], str) and isinstance(m["runs"], dict)):
+                raise ValueError("a set without cpu, isa and runs")
+        return sets
+    except (ValueError, KeyError, TypeError) as e:
+        sys.exit(f"{MANIFEST}: malformed ({e}); golden.py --update writes it again")
 
 
 def write_manifest(sets):
@@ -90,14 +98,17 @@ def write_manifest(sets):
 
 
 def source_commit(src):
-    """The commit whose outputs these are, "-dirty" when the tree has changes beyond it."""
+    """The commit the outputs were made from, "-dirty" when the tree had changes beyond it (as when
+    --update runs before the commit that changes the outputs: that commit is the next one)."""
     r = subprocess.run(["git", "-C", src, "describe", "--always", "--dirty", "--abbrev=7", "--exclude=*"],
                        capture_output=True, text=True)
     return r.stdout.strip() if r.returncode == 0 else "unknown"
 
 
-def commands(b, src, shared, out):
-    """(name, argv, outputs folder or file prefix): every run is tiny (the whole set takes ~15 s)."""
+def commands(b, src, shared, out, skipped=None):
+    """(name, argv, outputs folder or file prefix): every run is tiny (the whole set takes ~15 s).
+    The names of runs left out for want of ../shared data go to `skipped`."""
+    skipped = [] if skipped is None else skipped
     box = os.path.join(src, "scenes/cornell-box/scene.json")
     edits = os.path.join(src, "scenes/cornell-box/edits-demo.json")
     small_refiner = ["--refiner-iterations", "4", "--refiner-expansion", "1"]
@@ -119,11 +130,15 @@ def commands(b, src, shared, out):
                   ("classroom", "scenes/classroom/scene_constant.xml", "32x24", "2")]
     for name, rel, res, spp in xml_scenes:
         path = os.path.join(shared, rel)
-        if os.path.exists(path):
+        if not os.path.exists(path):
+            skipped.append(f"render_{name}")
+        else:
             runs.append((f"render_{name}", [b, "render", path, "--spp", spp, "--res", res,
                                             "--out", f"{out}/render_{name}/r.exr"]))
     cbox = os.path.join(shared, "scenes/cbox/cbox_specular.xml")
-    if os.path.exists(cbox) and os.path.isdir(os.path.join(shared, "models/taesd3")):
+    if not (os.path.exists(cbox) and os.path.isdir(os.path.join(shared, "models/taesd3"))):
+        skipped.append("fit_cbox_encoded")
+    else:
         runs.append(("fit_cbox_encoded", [b, "fit", cbox, "--encode", "--encode-res", "64x64", "--ref-spp", "8",
                                           "--iterations", "10", "--spp", "2", "--final-spp", "4", *small_refiner,
                                           "--out", f"{out}/fit_cbox_encoded"]))
@@ -193,10 +208,16 @@ def main():
     args = ap.parse_args()
     shared = args.shared or os.environ.get("LATENTPT_SHARED") or os.path.join(args.src, "..", "shared")
 
+    sets = stored_sets()  # before the runs: a missing or malformed manifest fails at once
+    if not sets and not args.update:
+        print(f"{MANIFEST}: missing or empty; golden.py --update stores the hashes", file=sys.stderr)
+        return 1
+    mine = [m for m in sets if (m["cpu"], m["isa"]) == this_machine()]
+    skipped = []
     with tempfile.TemporaryDirectory(prefix="latentpt-golden-") as tmp:
         out = args.out or tmp
         current = {}
-        for name, argv in commands(args.bin, args.src, shared, out):
+        for name, argv in commands(args.bin, args.src, shared, out, skipped):
             r = subprocess.run([*argv, "-q"], capture_output=True, text=True)
             if r.returncode != 0:
                 print(f"{name}: exit {r.returncode}\n{r.stderr}", file=sys.stderr)
@@ -204,14 +225,9 @@ def main():
             folder = os.path.join(out, name)
             current[name] = hash_outputs(folder)
 
-    sets = stored_sets()
-    if not sets and not args.update:
-        print(f"{MANIFEST}: missing or empty; golden.py --update stores the hashes", file=sys.stderr)
-        return 1
-    mine = [m for m in sets if (m["cpu"], m["isa"]) == this_machine()]
     if args.update or args.add_machine:
         stored_runs = {name for m in sets for name in m["runs"]} if args.add_machine else set()
-        not_run = sorted(stored_runs - current.keys()) or ([] if os.path.isdir(shared) else [shared])
+        not_run = sorted((stored_runs - current.keys()) | set(skipped))
         if not_run:
             print(f"not run here (no ../shared data?): {', '.join(not_run)}; a set without them checks less: "
                   "nothing stored", file=sys.stderr)
