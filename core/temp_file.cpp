@@ -14,8 +14,9 @@ constexpr int kSlots = 64;
 constexpr size_t kPathBytes = 4096;
 /// A slot's life: Free → Writing (taken, its path being copied) → Ready (the handler may unlink
 /// it) → Free when its TemporaryFile ends. The handler moves Ready → Removing before it reads the
-/// path, and nothing moves a slot out of Removing: another thread can then neither release the
-/// slot nor take it and copy a new path over the one unlink is reading (the process is ending).
+/// path (and unlinks slots another handler moved there too), and nothing moves a slot out of
+/// Removing: another thread can then neither release the slot nor take it and copy a new path
+/// over the one unlink is reading (the process is ending).
 enum SlotState : int { Free, Writing, Ready, Removing };
 struct Slot {
     std::atomic<int> state{Free};
