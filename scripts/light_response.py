@@ -47,6 +47,10 @@ def display(linear):
     return (np.clip(linear, 0, 1) ** GAMMA).astype(np.float32)
 
 
+def display_inverse(display_values):
+    return np.clip(display_values, 0, 1).astype(np.float64) ** (1 / GAMMA)
+
+
 def regression_slope(predicted, true, what):
     """Least-squares slope of `predicted` on `true` through the origin."""
     p, t = predicted.ravel(), true.ravel()
@@ -92,8 +96,7 @@ def exposure(args):
         vae = latentpt.Vae.from_fit(args.fit)
         with open(os.path.join(args.fit, "fit.json")) as f:
             manifest = json.load(f)
-        w, h = manifest["latent_width"], manifest["latent_height"]
-    except (ValueError, RuntimeError, OSError, KeyError) as e:
+    except (ValueError, RuntimeError, OSError) as e:
         sys.exit(f"{args.fit}: not a fit folder this can read: {e}")
     if manifest.get("ref_tone", "clip") != "clip":
         sys.exit(f"{args.fit}: fitted with --ref-tone {manifest['ref_tone']}; exposure compares clipped linear RGB")
@@ -103,12 +106,13 @@ def exposure(args):
     values, raw = {name: np.array(model.value(name), np.float32) for name in emission}, model.raw
 
     def decoded():
-        return display_inverse(vae.decode(model.render(width=w, height=h, spp=args.spp, seed=5)))
+        return display_inverse(vae.decode(model.render(spp=args.spp, seed=5)))  # at the fit's latent size
 
     picture = decoded()
     base = block_means(picture, args.fit)
     # the fit's own scene (its defines and sampler), at the size the VAE decodes to
     rgb = model.scene.render(spp=args.spp, width=picture.shape[1], height=picture.shape[0], seed=1)
+    truth_at_1 = block_means(np.clip(rgb, 0, 1), args.fit)
     measured = 0
     for k in args.k:
         try:
@@ -120,16 +124,12 @@ def exposure(args):
             continue
         finally:
             model.raw = raw
-        truth = block_means(np.clip(k * rgb, 0, 1), args.fit) - block_means(np.clip(rgb, 0, 1), args.fit)
+        truth = block_means(np.clip(k * rgb, 0, 1), args.fit) - truth_at_1
         s = regression_slope(scaled - base, truth, f"k = {k:g}")
         print(f"{args.fit} k = {k:g}: slope {s:.3f}")
         measured += 1
     if measured == 0:
         sys.exit(f"{args.fit}: no k could be rendered")
-
-
-def display_inverse(display_values):
-    return np.clip(display_values, 0, 1).astype(np.float64) ** 2.2
 
 
 def read_linear_rgb(path, scratch):

@@ -105,10 +105,9 @@ def source_commit(src):
     return r.stdout.strip() if r.returncode == 0 else "unknown"
 
 
-def commands(b, src, shared, out, skipped=None):
+def commands(b, src, shared, out, skipped):
     """(name, argv, outputs folder or file prefix): every run is tiny (the whole set takes ~15 s).
     The names of runs left out for want of ../shared data go to `skipped`."""
-    skipped = [] if skipped is None else skipped
     box = os.path.join(src, "scenes/cornell-box/scene.json")
     edits = os.path.join(src, "scenes/cornell-box/edits-demo.json")
     small_refiner = ["--refiner-iterations", "4", "--refiner-expansion", "1"]
@@ -212,7 +211,8 @@ def main():
     if not sets and not args.update:
         print(f"{MANIFEST}: missing or empty; golden.py --update stores the hashes", file=sys.stderr)
         return 1
-    mine = [m for m in sets if (m["cpu"], m["isa"]) == this_machine()]
+    cpu, isa = this_machine()
+    mine = [m for m in sets if (m["cpu"], m["isa"]) == (cpu, isa)]
     skipped = []
     with tempfile.TemporaryDirectory(prefix="latentpt-golden-") as tmp:
         out = args.out or tmp
@@ -239,8 +239,8 @@ def main():
             print("this machine's outputs differ from the hashes already stored for it: if they changed on purpose, "
                   "use --update", file=sys.stderr)
             return 1
-        kept = [m for m in sets if args.add_machine and (m["cpu"], m["isa"]) != this_machine()]
-        write_manifest(kept + [{"cpu": cpu_model(), "isa": cpu_isa(), "commit": source_commit(args.src),
+        kept = [m for m in sets if args.add_machine and (m["cpu"], m["isa"]) != (cpu, isa)]
+        write_manifest(kept + [{"cpu": cpu, "isa": isa, "commit": source_commit(args.src),
                                 "runs": current}])
         print(f"stored {sum(len(v) for v in current.values())} hashes from {len(current)} runs for this machine "
               f"in {MANIFEST} ({len(kept)} other machine kinds kept)")
@@ -248,7 +248,7 @@ def main():
 
     if not mine:
         kinds = "; ".join(f"'{m['cpu']}' ({m['isa']})" for m in sets)
-        print(f"no hashes stored for this machine, '{cpu_model()}' ({cpu_isa()}); stored for: {kinds}: skipped")
+        print(f"no hashes stored for this machine, '{cpu}' ({isa}); stored for: {kinds}: skipped")
         return 77
     stored = mine[0]
     differ, missing = [], []
