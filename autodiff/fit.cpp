@@ -103,17 +103,69 @@ double add_emitter_response_decay(ParamStore& ps, float lambda) {
     return penalty;
 }
 
-FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o,
-                    FitState state, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
-    const size_t n = size_t(width) * height * kLatentChannels;
+float exposure_at(const FitOptions& o, int iteration) {
+    return o.exposures.empty() ? 1.f : o.exposures[size_t(iteration) % o.exposures.size()];
+}
+
+void scale_emission_gradients(ParamStore& ps, float k) {
+    for (size_t s = 0; s < ps.slice_count(); ++s) {
+        if (ps.slice(int(s)).kind != "Le") continue;
+        float* g = ps.grad_value(int(s));
+        for (int c = 0; c < ps.slice(int(s)).channels; ++c) g[c] *= k;
+    }
+}
+
+namespace {
+
+std::string exposure_name(float k) {
+    std::ostringstream s;
+    s << k;
+    return s.str();
+}
+
+void check_target(const std::vector<float>& target, size_t n, float exposure) {
+    const std::string which = exposure == 1.f ? "target" : "target of exposure " + exposure_name(exposure);
     if (target.size() != n)
-        throw std::invalid_argument("fit: target has " + std::to_string(target.size()) + " values, expected " +
+        throw std::invalid_argument("fit: " + which + " has " + std::to_string(target.size()) + " values, expected " +
                                     std::to_string(n));
     size_t bad_index = 0;
     if (!check_finite(target.data(), n, &bad_index))
-        throw std::invalid_argument("fit: target value " + std::to_string(bad_index) + " (pixel " +
+        throw std::invalid_argument("fit: " + which + " value " + std::to_string(bad_index) + " (pixel " +
                                     std::to_string(bad_index / kLatentChannels) + ", channel " +
                                     std::to_string(bad_index % kLatentChannels) + ") is not finite");
+}
+
+/// targets[i] for each position of the exposure cycle; throws naming an exposure without one.
+std::vector<const std::vector<float>*> targets_of_cycle(const std::vector<ExposureTarget>& targets, const FitOptions& o,
+                                                        size_t n) {
+    const std::vector<float> cycle = o.exposures.empty() ? std::vector<float>{1.f} : o.exposures;
+    std::vector<const std::vector<float>*> out;
+    for (float k : cycle) {
+        if (!(k > 0.f) || !std::isfinite(k))
+            throw std::invalid_argument("fit: exposure " + exposure_name(k) + " is not a finite number > 0");
+        const std::vector<float>* found = nullptr;
+        for (const ExposureTarget& t : targets)
+            if (t.exposure == k) found = &t.latent;
+        if (!found) throw std::invalid_argument("fit: no target for exposure " + exposure_name(k));
+        check_target(*found, n, k);
+        out.push_back(found);
+    }
+    return out;
+}
+
+}  // namespace
+
+FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height, const FitOptions& o,
+                    FitState state, const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
+    return fit_latent(model, std::vector<ExposureTarget>{{1.f, target}}, width, height, o, std::move(state),
+                      on_iteration);
+}
+
+FitState fit_latent(LatentModel& model, const std::vector<ExposureTarget>& targets, int width, int height,
+                    const FitOptions& o, FitState state,
+                    const std::function<bool(const FitRecord&, const FitState&)>& on_iteration) {
+    const size_t n = size_t(width) * height * kLatentChannels;
+    const std::vector<const std::vector<float>*> cycle = targets_of_cycle(targets, o, n);
     ParamStore& ps = model.params();
     Adam adam(ps.raw().size());
     if (!state.adam.m.empty()) adam.set_state(state.adam);
@@ -136,6 +188,10 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
     const bool stopped = o.patience > 0 && state.bad_updates >= o.patience;
     for (int it = stopped ? o.iterations : state.next_iteration; it < o.iterations; ++it) {
         const RenderOptions ro = iteration_options(model, o, width, height, K > 0 ? it - it % K : it);
+        // The lights at this iteration's exposure; the paths do not depend on it, so stored ones serve.
+        const float exposure = exposure_at(o, it);
+        const std::vector<float>& target = *cycle[size_t(it) % cycle.size()];
+        if (exposure != 1.f) model.scale_emission(exposure);
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
         std::vector<float> linear;
         if (K == 0)
@@ -152,6 +208,10 @@ FitState fit_latent(LatentModel& model, const std::vector<float>& target, int wi
         ps.zero_grad();
         if (K == 0) backward_latent(model, ro, d_image);
         else replay_backward(model, *records, d_image);
+        if (exposure != 1.f) {
+            scale_emission_gradients(ps, exposure);
+            model.sync();  // the lights as the parameters say, for the decays and the step
+        }
         loss += add_emission_decay(ps, o.emission_decay) + add_emitter_response_decay(ps, o.emitter_response_decay);
         ps.backward();
         const float lr = schedule.lr_at(it);

@@ -28,6 +28,11 @@ struct FitOptions {
     /// light's own pixels both act as flat terms beside L̃e; pinned near 0, those pixels fix L̃e
     /// without pulling down an L̃e that the room's light needs.
     float emitter_response_decay = 0.f;
+    /// Light exposures the iterations cycle through: iteration i renders with every light's L̃e
+    /// times k = exposures[i % size] and matches the target of that k (docs/fitting.md "Exposure
+    /// cycle"). Empty = {1}: the training view alone. A view shows the sum of the terms; how much
+    /// of it is light (Ĩe) and how much flat response (Ĩa, Ĩc) only a change of the light shows.
+    std::vector<float> exposures;
     ToneCurve tone = ToneCurve::Clip;
     int patience = 300;  ///< early stopping on the smoothed loss; 0 = off
     float min_delta = 1e-5f;
@@ -40,6 +45,13 @@ struct FitOptions {
     int reuse_paths = 8;
     int checkpoint_every = 100;  ///< 0 = never; rounded up to a multiple of reuse_paths
     std::string checkpoint_dir;  ///< empty = no checkpoints
+};
+
+/// The latent a fit matches while every light is `exposure` times as bright: exposure 1 is the
+/// training view's target.
+struct ExposureTarget {
+    float exposure = 1.f;
+    std::vector<float> latent;
 };
 
 struct FitRecord {
@@ -85,6 +97,16 @@ std::vector<float> render_toned(const LatentModel& model, const RenderOptions& o
 FitState fit_latent(LatentModel& model, const std::vector<float>& target, int width, int height,
                     const FitOptions& options, FitState state = {},
                     const std::function<bool(const FitRecord&, const FitState&)>& on_iteration = {});
+/// The same with one target per light exposure: every value of options.exposures (1 if empty)
+/// needs one; std::invalid_argument otherwise.
+FitState fit_latent(LatentModel& model, const std::vector<ExposureTarget>& targets, int width, int height,
+                    const FitOptions& options, FitState state = {},
+                    const std::function<bool(const FitRecord&, const FitState&)>& on_iteration = {});
+/// The light exposure iteration `iteration` fits: options.exposures cycled, 1 if empty.
+float exposure_at(const FitOptions& options, int iteration);
+/// Turns the gradients of a render with every light's L̃e times k into those of L̃e itself:
+/// d/dL̃e = k · d/d(k·L̃e) on every "Le" slice.
+void scale_emission_gradients(ParamStore& params, float k);
 
 /// Checkpoint = params (raw) + Adam state + early-stopping state + history, written atomically
 /// into `dir`; load throws std::runtime_error naming the file on any mismatch.

@@ -96,4 +96,11 @@ void LatentModel::sync() {
     m_terms.background = vec(m_background);
 }
 
+void LatentModel::scale_emission(float k) {
+    // only the entries sync() writes, so that the next sync() restores them all
+    for (size_t i = 0; i < m_scene.shapes.size(); ++i)
+        if (m_slots[i].Le >= 0) m_spectra.radiance[m_scene.shapes[i].emitter] *= k;
+    if (m_env_slot >= 0) m_spectra.radiance[m_scene.environment] *= k;
+}
+
 }  // namespace lpt

@@ -43,6 +43,10 @@ public:
 
     /// Writes ParamStore values into spectra and terms (call after every optimiser step).
     void sync();
+    /// Every light's L̃e (emitting shapes and the environment) times k in the spectra the renderer
+    /// reads, the parameters untouched: the scene with all its lights k times as bright, which
+    /// the next sync() undoes. Ĩe is linear in L̃e, so its render is k · Ĩe.
+    void scale_emission(float k);
 
     const Scene& scene() const { return m_scene; }
     ParamStore& params() { return m_params; }
