@@ -201,6 +201,12 @@ struct Cli {
                "shape; 0 = off (docs/fitting.md (18))")
             ->capture_default_str()
             ->check(non_negative());
+        fit->add_option("--exposures", f.job.options.exposures,
+                        "light exposures the iterations cycle through, e.g. 1,0.5,1,2: an iteration with k fits the "
+                        "render with every light's Le times k to the reference with every light k times as bright "
+                        "(docs/fitting.md \"Exposure cycle\"); default: 1 only")
+            ->delimiter(',')
+            ->check(CLI::PositiveNumber);
     }
 
     /// The optimiser, the target's RGB reference, the VAE, stage 2: the rest of fit's options.

@@ -28,7 +28,18 @@ namespace {
 struct Target {
     std::vector<float> data;
     int width = 0, height = 0;  ///< latent resolution
+    /// The training view with every light k times as bright, encoded, for each k ≠ 1 of
+    /// --exposures (docs/fitting.md "Exposure cycle").
+    std::vector<ExposureTarget> exposed;
 };
+
+/// The distinct values of `exposures` other than 1, in their first order.
+std::vector<float> exposures_other_than_1(const std::vector<float>& exposures) {
+    std::vector<float> out;
+    for (float k : exposures)
+        if (k != 1.f && std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+    return out;
+}
 
 Target load_target_exr(const std::string& path) {
     Image img = read_image(path);
@@ -46,17 +57,24 @@ Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, con
     int iw = 0, ih = 0;
     parse_resolution(job.encode_res, iw, ih, "--encode-res");
     const fs::path out(job.out);
-    std::vector<float> ref_rgb;
+    std::vector<float> ref_rgb, linear;
     Target t;
     std::string cached;
     if (!job.reference_cache.empty())
         cached = (fs::path(job.reference_cache) / training_reference_key(iw, ih, job.ref_spp, job.ref_tone)).string();
+    const bool exposed = !exposures_other_than_1(job.options.exposures).empty();
     t.data = cached_encoded_reference(scene, iw, ih, job.ref_spp, kReferenceSeed, job.ref_tone, vae, cached,
                                       reference_source(scene, job.defines), vae_encoder_fingerprint(job.vae),
-                                      (out / "reference.png").string(), ref_rgb, report);
+                                      (out / "reference.png").string(), ref_rgb, report, exposed ? &linear : nullptr);
     write_exr((out / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}, true});
     t.width = iw / 8;
     t.height = ih / 8;
+    for (float k : exposures_other_than_1(job.options.exposures)) {
+        // k·I display-mapped: a light's own pixels stay clipped, the room's light scales
+        std::vector<float> rgb(linear.size());
+        for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = display_value(k * linear[i], job.ref_tone);
+        t.exposed.push_back({k, vae.encode(rgb, iw, ih)});
+    }
     return t;
 }
 
@@ -105,7 +123,9 @@ bool optimise(LatentModel& model, const Target& target, const FitOptions& o, Fit
         cancelled = !report.step(p);
         return !cancelled;
     };
-    state = fit_latent(model, target.data, target.width, target.height, o, state, on_iteration);
+    std::vector<ExposureTarget> targets = target.exposed;
+    targets.push_back({1.f, target.data});
+    state = fit_latent(model, targets, target.width, target.height, o, state, on_iteration);
     return !cancelled;
 }
 
@@ -202,6 +222,11 @@ void validate(const FitJob& job) {
         if (!(value >= 0.f) || !std::isfinite(value))
             throw std::invalid_argument(std::string(flag) + " must be a finite number >= 0, got " +
                                         std::to_string(value));
+    for (float k : o.exposures) require(k > 0.f && std::isfinite(k), "--exposures", "finite numbers > 0", k);
+    if (!exposures_other_than_1(o.exposures).empty() && !job.encode)
+        throw std::invalid_argument(
+            "fit --exposures: a light exposure other than 1 needs --encode (the RGB "
+            "reference it scales; a given --target or a synthetic one has none)");
     int w = 0, h = 0;  // checked here, before run_fit touches an existing folder's checkpoint
     if (job.target.empty()) {
         const char* flag = job.encode ? "--encode-res" : "--synthetic-res";

@@ -38,6 +38,7 @@ nlohmann::json stage1_settings(const FitJob& job) {
                      {"huber_delta", o.huber_delta},
                      {"emission_decay", o.emission_decay},
                      {"emitter_response_decay", o.emitter_response_decay},
+                     {"exposures", o.exposures},
                      {"patience", o.patience},
                      {"min_delta", o.min_delta},
                      {"smoothing", o.smoothing},
@@ -59,8 +60,11 @@ namespace {
 /// texts, since session 55), and one without the key
 /// resumes whatever the setting is now, as it did before.
 const nlohmann::json& settings_added_later() {
-    static const nlohmann::json added = {
-        {"emitter_response_decay", 0.0}, {"vae_encoder", nullptr}, {"scene_text", nullptr}, {"target_file", nullptr}};
+    static const nlohmann::json added = {{"emitter_response_decay", 0.0},
+                                         {"exposures", nlohmann::json::array()},
+                                         {"vae_encoder", nullptr},
+                                         {"scene_text", nullptr},
+                                         {"target_file", nullptr}};
     return added;
 }
 

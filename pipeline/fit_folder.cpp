@@ -148,6 +148,7 @@ nlohmann::json fit_manifest(const FitJob& job, int w, int h, double final_loss, 
                    {"reuse_paths", o.reuse_paths},
                    {"emission_decay", o.emission_decay},
                    {"emitter_response_decay", o.emitter_response_decay},
+                   {"exposures", o.exposures},
                    {"skipped_steps", state.skipped_steps}};
     return m;
 }

@@ -43,27 +43,51 @@ std::vector<float> display_rgb(const Image& img, const std::string& path) {
     return rgb;
 }
 
-std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
-                                        const std::string& tone, const Vae& vae, const std::string& save_png,
-                                        std::vector<float>* display_rgb, const Reporter& report) {
-    const int f = vae.convention().downsample;
-    if (width % f || height % f)
-        throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) +
-                                    " in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
+std::vector<float> linear_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                       const Reporter& report) {
     SceneSpectra<3> spectra = SceneSpectra<3>::from_description(scene);
     RenderOptions o = RenderOptions::from_scene(scene, width, height, spp, seed);
     RenderStats st;
     std::vector<float> rgb = render_path<3>(scene, spectra, o, &st).develop();
-    for (float& v : rgb) v = display_value(v, tone);
     std::ostringstream msg;
     msg << "reference: " << width << "x" << height << " at " << spp << " spp in " << st.seconds << " s";
     report.say(msg.str());
+    return rgb;
+}
+
+std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                        const std::string& tone, const Vae& vae, const std::string& save_png,
+                                        std::vector<float>* display_rgb, const Reporter& report,
+                                        std::vector<float>* linear_rgb) {
+    const int f = vae.convention().downsample;
+    if (width % f || height % f)
+        throw std::invalid_argument("reference resolution must be a multiple of " + std::to_string(f) +
+                                    " in both axes, got " + std::to_string(width) + "x" + std::to_string(height));
+    std::vector<float> rgb = linear_reference_of(scene, width, height, spp, seed, report);
+    if (linear_rgb) *linear_rgb = rgb;
+    for (float& v : rgb) v = display_value(v, tone);
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, rgb, {}});
     if (display_rgb) *display_rgb = rgb;
     return vae.encode(rgb, width, height);
 }
 
 namespace {
+
+/// The linear RGB a reference's display values came from: `file` if it holds this source's, else
+/// traced again (the same seed gives the same pixels) and written there. Caches written before
+/// session 57 hold display values only.
+std::vector<float> cached_linear_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                           const std::string& file, const std::string& source, const Reporter& report) {
+    if (std::filesystem::exists(file)) {
+        Image cached = read_fit_image(file, 3, width, height);
+        if (cached.source == source && !cached.display) return std::move(cached.data);
+    }
+    report.say(file + ": tracing the reference's linear values again (the cache holds its display values only)");
+    std::vector<float> linear = linear_reference_of(scene, width, height, spp, seed, report);
+    write_exr(file, Image{width, height, 3, linear, {"R", "G", "B"}, false, source});
+    return linear;
+}
+
 /// "<W>x<H>_<spp>spp_<tone>": the part of every cache name that says how a reference was traced.
 std::string trace_settings_key(int width, int height, int spp, const std::string& tone) {
     return std::to_string(width) + "x" + std::to_string(height) + "_" + std::to_string(spp) + "spp_" + tone;
@@ -103,21 +127,29 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
                                             const std::string& source, const std::string& encoder,
                                             const std::string& save_png, std::vector<float>& display_rgb,
-                                            const Reporter& report) {
+                                            const Reporter& report, std::vector<float>* linear_rgb) {
     namespace fs = std::filesystem;
     if (cache_stem.empty())
-        return encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
+        return encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report,
+                                    linear_rgb);
     const std::string rgb_file = cache_stem + ".exr", latent_file = cache_stem + "_latent.exr";
+    const std::string linear_file = cache_stem + "_linear.exr";
+    const auto write_linear_file = [&](const std::vector<float>& linear) {
+        write_exr(linear_file, Image{width, height, 3, linear, {"R", "G", "B"}, false, source});
+    };
     const int f = vae.convention().downsample, channels = vae.convention().channels;
     const std::string encoded_by = source + " encoded by " + encoder;
     const auto write_latent_file = [&](const std::vector<float>& latent) {
         write_exr(latent_file, Image{width / f, height / f, channels, latent, {}, false, encoded_by});
     };
     if (!fs::exists(rgb_file)) {
+        std::vector<float> linear;
         std::vector<float> latent =
-            encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report);
+            encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report, &linear);
         fs::create_directories(fs::path(cache_stem).parent_path());
         write_latent_file(latent);
+        write_linear_file(linear);
+        if (linear_rgb) *linear_rgb = std::move(linear);
         write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}, true, source});
         return latent;
     }
@@ -138,6 +170,7 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
         } catch (const std::exception&) {}
     }
     display_rgb = std::move(cached.data);
+    if (linear_rgb) *linear_rgb = cached_linear_reference(scene, width, height, spp, seed, linear_file, source, report);
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});
     if (fs::exists(latent_file)) {
         Image latent = read_fit_image(latent_file, channels, width / f, height / f);

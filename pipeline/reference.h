@@ -37,9 +37,14 @@ constexpr uint64_t kReferenceSeed = 0x5eed;
 /// (if given) its values. Throws if the size is not a multiple of the VAE's downsampling.
 /// Another seed gives an independent reference of the same view (same sampler): two of them
 /// measure a reference's own noise (docs/metrics.md "Reference noise").
+/// `linear_rgb` (if given) receives the traced values before the display mapping.
 std::vector<float> encoded_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                         const std::string& tone, const Vae& vae, const std::string& save_png,
-                                        std::vector<float>* display_rgb = nullptr, const Reporter& report = {});
+                                        std::vector<float>* display_rgb = nullptr, const Reporter& report = {},
+                                        std::vector<float>* linear_rgb = nullptr);
+/// The path-traced RGB of encoded_reference_of before its display mapping.
+std::vector<float> linear_reference_of(const Scene& scene, int width, int height, int spp, uint64_t seed,
+                                       const Reporter& report = {});
 
 /// The cache name of a view's training reference ("training_<W>x<H>_<spp>spp_<tone>"): fits
 /// and the unedited frames of edit sequences share it.
@@ -77,11 +82,12 @@ std::string reference_source(const Scene& scene, const std::map<std::string, std
 /// (two scenes or sequences of one name sharing a cache folder). The latent file records `source`
 /// and `encoder` (vae_encoder_fingerprint); one another VAE encoded is encoded again. A cached EXR
 /// without the display mark or the records (written before EXRs had them) is rewritten with them,
-/// its pixels unchanged.
+/// its pixels unchanged. A traced reference's linear values go to `cache_stem`_linear.exr too;
+/// `linear_rgb` (if given) receives them, traced again where the cache lacks them.
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
                                             const std::string& source, const std::string& encoder,
                                             const std::string& save_png, std::vector<float>& display_rgb,
-                                            const Reporter& report = {});
+                                            const Reporter& report = {}, std::vector<float>* linear_rgb = nullptr);
 
 }  // namespace lpt::pipeline

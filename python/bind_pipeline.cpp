@@ -114,6 +114,7 @@ bool apply_fit_option(pipeline::FitJob& job, const std::string& k, const py::han
     else if (k == "patience") o.patience = value.cast<int>();
     else if (k == "emission_decay") o.emission_decay = value.cast<float>();
     else if (k == "emitter_response_decay") o.emitter_response_decay = value.cast<float>();
+    else if (k == "exposures") o.exposures = value.cast<std::vector<float>>();
     else if (k == "reuse_paths") o.reuse_paths = value.cast<int>();
     else if (k == "checkpoint_every") o.checkpoint_every = value.cast<int>();
     else if (k == "tone") o.tone = parse_tone_curve(value.cast<std::string>());

@@ -151,6 +151,17 @@ def check_arguments(ap, a):
         ap.error(f"--out {a.out} is a file; name a folder (new or an earlier run's)")
 
 
+def exposure_list(text):
+    """--exposures: comma-separated finite numbers > 0."""
+    try:
+        values = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"comma-separated numbers, got '{text}'")
+    if not all(math.isfinite(k) and k > 0 for k in values):
+        raise argparse.ArgumentTypeError(f"finite numbers > 0, got '{text}'")
+    return values
+
+
 def is_dry_run(snakemake_args):
     """Snakemake's --dry-run, -n, or -n among combined short flags (-np)."""
     return any(x in ("--dry-run", "--dryrun") or (x.startswith("-") and not x.startswith("--") and "n" in x[1:])
@@ -182,6 +193,9 @@ def main():
                     help="every fit's --emission-decay (default: the preset's, else 0; docs/fitting.md (17))")
     ap.add_argument("--emitter-response-decay", type=float, default=None,
                     help="every fit's --emitter-response-decay (default: the preset's, else 0; docs/fitting.md (18))")
+    ap.add_argument("--exposures", type=exposure_list, default=None,
+                    help="every fit's --exposures, the light exposures its iterations cycle through, e.g. 1,0.5,1,2 "
+                         "(default: the preset's, else 1 only; docs/fitting.md \"Exposure cycle\")")
     ap.add_argument("--refiner-latent-target", choices=["encoded", "compensated"], default=None,
                     help="the refiner target of the fits that refine (default: the preset's, else encoded; docs/refiner.md "
                          "\"Latent target\")")
@@ -213,7 +227,8 @@ def main():
                    paper=a.paper, frame_step=a.frame_step, emission_decay=a.emission_decay, param=a.param,
                    emitter_response_decay=a.emitter_response_decay, second_references=a.second_references,
                    refiner_latent_target=a.refiner_latent_target, refiner_dropout=a.refiner_dropout,
-                   refiner_emitters=None if a.refiner_emitters is None else a.refiner_emitters == "on")
+                   refiner_emitters=None if a.refiner_emitters is None else a.refiner_emitters == "on",
+                   exposures=a.exposures)
     for s in c["scenes"]:
         if s not in X.SCENES:
             sys.exit(f"experiment: unknown scene '{s}' (have {', '.join(X.SCENES)})")

@@ -165,7 +165,9 @@ def settings_line(c):
             f"{', latent target ' + c['refiner_latent_target'] if c.get('refiner_latent_target', 'encoded') != 'encoded' else ''}"
             f"{dropout}), "
             f"parameterisation {c.get('param', 'code')}, emission decay {c.get('emission_decay', 0):g}, "
-            f"emitter response decay {c.get('emitter_response_decay', 0):g}, frames {frames or 'as in the edit files'}"
+            f"emitter response decay {c.get('emitter_response_decay', 0):g}"
+            f"{', light exposures ' + ','.join(f'{k:g}' for k in c['exposures']) if c.get('exposures') else ''}, "
+            f"frames {frames or 'as in the edit files'}"
             f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp")
 
 
@@ -343,7 +345,7 @@ PAPER = {"scenes": ["cbox-specular", "veach-bidir", "dining-room"],
 def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_res=None, frames=None, ref_spp=None,
              fit_iterations=None, refiner_iterations=None, spp=64, chunk=8, paper=False, frame_step=None,
              emission_decay=None, emitter_response_decay=None, param=None, second_references=False,
-             refiner_latent_target=None, refiner_dropout=None, refiner_emitters=None):
+             refiner_latent_target=None, refiner_dropout=None, refiner_emitters=None, exposures=None):
     """The workflow's config (JSON-able): --quick's small sizes, --paper's preset or the full run's;
     flags given explicitly win over the preset's values."""
     p = PAPER if paper else {}
@@ -363,6 +365,7 @@ def settings(quick=False, scenes=None, out=None, bin=None, shared=None, image_re
             "emission_decay": p.get("emission_decay", 0) if emission_decay is None else emission_decay,
             "emitter_response_decay": p.get("emitter_response_decay", 0) if emitter_response_decay is None else emitter_response_decay,
             "param": p.get("param", "code") if param is None else param,
+            "exposures": list(p.get("exposures", [])) if exposures is None else list(exposures),
             "frames": frames or (3 if quick else None), "frame_step": frame_step or p.get("frame_step", 1),
             "ref_spp": ref_spp or p.get("ref_spp") or (32 if quick else None),
             # an explicit --ref-spp is every reference's, the training view's too
@@ -471,6 +474,8 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
         cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     if decay and c.get("emitter_response_decay", 0):
         cmd += ["--emitter-response-decay", repr(float(c["emitter_response_decay"]))]
+    if decay and c.get("exposures"):
+        cmd += ["--exposures", ",".join(f"{k:g}" for k in c["exposures"])]
     # named only when not the default, never over a fit's own (the baseline's classic), and not
     # in the training-reference job's scratch fit (`decay` False), whose command stays as it was
     if decay and c.get("param", "code") != "code" and "--param" not in extra:

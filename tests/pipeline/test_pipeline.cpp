@@ -253,6 +253,14 @@ TEST(Pipeline, ACheckpointFromBeforeASettingExistedResumesAtItsOldValueOnly) {
               std::string::npos);
     old.erase("vae_encoder");
     EXPECT_EQ(pipeline::settings_difference(old, pipeline::stage1_settings(job)), "");
+    // the exposure cycle (since session 57): a checkpoint without it resumes only a fit without one
+    ASSERT_TRUE(old.contains("exposures"));
+    old.erase("exposures");
+    EXPECT_EQ(pipeline::settings_difference(old, pipeline::stage1_settings(job)), "");
+    pipeline::FitJob cycled = job;
+    cycled.options.exposures = {1.f, 2.f};
+    EXPECT_NE(pipeline::settings_difference(old, pipeline::stage1_settings(cycled)).find("exposures"),
+              std::string::npos);
     old.erase("emission_decay");
     EXPECT_NE(pipeline::settings_difference(old, pipeline::stage1_settings(job)).find("records no 'emission_decay'"),
               std::string::npos);

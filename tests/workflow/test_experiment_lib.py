@@ -76,6 +76,13 @@ class Preset(unittest.TestCase):
         c = X.settings(paper=True, emission_decay=1e-4, emitter_response_decay=0)
         self.assertIn("--emission-decay 0.0001", X.fit_command(c, "cbox-specular", "ea", 2))
         self.assertNotIn("--emitter-response-decay", X.fit_command(c, "cbox-specular", "ea", 2))
+        # the exposure cycle: every ablation fit's, never the training reference's scratch fit
+        self.assertNotIn("--exposures", X.fit_command(X.settings(paper=True), "cbox-specular", "ea", 2))
+        c = X.settings(paper=True, exposures=[1, 0.5, 1, 2])
+        for fit in ("e", "ea", "eac"):
+            self.assertIn("--exposures 1,0.5,1,2", X.fit_command(c, "cbox-specular", fit, 2))
+        self.assertNotIn("--exposures", X.training_reference_command(c, "cbox-specular", 2))
+        self.assertIn("light exposures 1,0.5,1,2", X.settings_line(c))
         # the parameterisation: named only when not code, never over the baseline's own classic
         self.assertNotIn("--param", X.fit_command(X.settings(paper=True), "cbox-specular", "ea", 2))
         gain = X.settings(param="gain")
@@ -365,6 +372,8 @@ class Arguments(unittest.TestCase):
         self.assertIn("--refiner-dropout must be in [0, 0.99]", self.refused("--quick", "--refiner-dropout", "5"))
         self.assertIn("--emission-decay must be a finite number", self.refused("--quick", "--emission-decay", "nan"))
         self.assertIn("two presets", self.refused("--quick", "--paper"))
+        for value in ("1,0", "1,-2", "1,x", "nan"):
+            self.assertIn("--exposures", self.refused("--quick", "--exposures", value))
         with tempfile.NamedTemporaryFile() as f:  # was a FileExistsError traceback
             self.assertIn("is a file; name a folder", self.refused("--quick", "--out", f.name))
 
