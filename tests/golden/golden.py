@@ -155,7 +155,7 @@ def image_hash(path):
 # Fields added to metrics.json or fit.json after the stored hashes, dropped when they hold the value that means
 # "as before": an output that gained a record of a default setting still matches its old hash.
 ADDED_DEFAULTS = {"noise_views": 1, "lr_decay": "none", "inference_window": 0, "augment": "none", "emission_decay": 0,
-                  "emitter_response_decay": 0, "inference_stride": 0, "latent_target": "encoded"}
+                  "emitter_response_decay": 0, "inference_stride": 0, "latent_target": "encoded", "exposures": []}
 
 
 def scrub(value):
