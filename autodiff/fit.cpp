@@ -135,6 +135,14 @@ void check_target(const std::vector<float>& target, size_t n, float exposure) {
                                     std::to_string(bad_index % kLatentChannels) + ") is not finite");
 }
 
+/// Calls model->sync() when it goes out of scope (unless null).
+struct ResyncOnExit {
+    LatentModel* model;
+    ~ResyncOnExit() {
+        if (model) model->sync();
+    }
+};
+
 /// targets[i] for each position of the exposure cycle; throws naming an exposure without one.
 std::vector<const std::vector<float>*> targets_of_cycle(const std::vector<ExposureTarget>& targets, const FitOptions& o,
                                                         size_t n) {
@@ -192,6 +200,8 @@ FitState fit_latent(LatentModel& model, const std::vector<ExposureTarget>& targe
         const float exposure = exposure_at(o, it);
         const std::vector<float>& target = *cycle[size_t(it) % cycle.size()];
         if (exposure != 1.f) model.scale_emission(exposure);
+        // an exception below leaves no model with scaled lights behind
+        const ResyncOnExit resync{exposure != 1.f ? &model : nullptr};
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
         std::vector<float> linear;
         if (K == 0)

@@ -32,6 +32,7 @@ struct FitOptions {
     /// times k = exposures[i % size] and matches the target of that k (docs/fitting.md "Exposure
     /// cycle"). Empty = {1}: the training view alone. A view shows the sum of the terms; how much
     /// of it is light (Ĩe) and how much flat response (Ĩa, Ĩc) only a change of the light shows.
+    /// The logged and smoothed losses (early stopping's too) are each iteration's own exposure's.
     std::vector<float> exposures;
     ToneCurve tone = ToneCurve::Clip;
     int patience = 300;  ///< early stopping on the smoothed loss; 0 = off

@@ -73,18 +73,34 @@ std::vector<float> encoded_reference_of(const Scene& scene, int width, int heigh
 
 namespace {
 
-/// The linear RGB a reference's display values came from: `file` if it holds this source's, else
-/// traced again (the same seed gives the same pixels) and written there. Caches written before
-/// session 57 hold display values only.
+/// The linear RGB whose display mapping `display` (the cached `display_file`) is: `file` where it
+/// holds this source's, else traced again (the same seed and sampler give the same pixels) and
+/// written there where the folder lets us (a cache another user owns stays as it is). Caches
+/// written before session 57 hold display values only. Throws, naming both files, where the
+/// linear values do not map to the cached display values (traced by another build or sampler):
+/// targets made from them would not be the training target's.
 std::vector<float> cached_linear_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
-                                           const std::string& file, const std::string& source, const Reporter& report) {
-    if (std::filesystem::exists(file)) {
-        Image cached = read_fit_image(file, 3, width, height);
-        if (cached.source == source && !cached.display) return std::move(cached.data);
+                                           const std::string& tone, const std::string& file, const std::string& source,
+                                           const std::vector<float>& display, const std::string& display_file,
+                                           const Reporter& report) {
+    std::vector<float> linear;
+    if (std::filesystem::exists(file)) try {
+            Image cached = read_fit_image(file, 3, width, height);
+            if (cached.source == source && !cached.display) linear = std::move(cached.data);
+        } catch (const std::exception&) {}  // unreadable or misshapen: traced again below
+    if (linear.empty()) {
+        report.say(file + ": tracing the reference's linear values again (the cache holds its display values only)");
+        linear = linear_reference_of(scene, width, height, spp, seed, report);
+        try {
+            write_exr(file, Image{width, height, 3, linear, {"R", "G", "B"}, false, source});
+        } catch (const std::exception&) {}
     }
-    report.say(file + ": tracing the reference's linear values again (the cache holds its display values only)");
-    std::vector<float> linear = linear_reference_of(scene, width, height, spp, seed, report);
-    write_exr(file, Image{width, height, 3, linear, {"R", "G", "B"}, false, source});
+    for (size_t i = 0; i < linear.size(); ++i)
+        if (!(std::abs(display_value(linear[i], tone) - display[i]) <= 1e-6f))
+            throw std::runtime_error(file + ": its linear values do not give the display values of " + display_file +
+                                     " (value " + std::to_string(i) +
+                                     "): traced by another build or sampler; delete both to trace the reference "
+                                     "again");
     return linear;
 }
 
@@ -134,9 +150,6 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
                                     linear_rgb);
     const std::string rgb_file = cache_stem + ".exr", latent_file = cache_stem + "_latent.exr";
     const std::string linear_file = cache_stem + "_linear.exr";
-    const auto write_linear_file = [&](const std::vector<float>& linear) {
-        write_exr(linear_file, Image{width, height, 3, linear, {"R", "G", "B"}, false, source});
-    };
     const int f = vae.convention().downsample, channels = vae.convention().channels;
     const std::string encoded_by = source + " encoded by " + encoder;
     const auto write_latent_file = [&](const std::vector<float>& latent) {
@@ -148,8 +161,10 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
             encoded_reference_of(scene, width, height, spp, seed, tone, vae, save_png, &display_rgb, report, &linear);
         fs::create_directories(fs::path(cache_stem).parent_path());
         write_latent_file(latent);
-        write_linear_file(linear);
-        if (linear_rgb) *linear_rgb = std::move(linear);
+        if (linear_rgb) {  // kept only where asked for (exposures): a full-size float image per frame
+            write_exr(linear_file, Image{width, height, 3, linear, {"R", "G", "B"}, false, source});
+            *linear_rgb = std::move(linear);
+        }
         write_exr(rgb_file, Image{width, height, 3, display_rgb, {"R", "G", "B"}, true, source});
         return latent;
     }
@@ -170,7 +185,9 @@ std::vector<float> cached_encoded_reference(const Scene& scene, int width, int h
         } catch (const std::exception&) {}
     }
     display_rgb = std::move(cached.data);
-    if (linear_rgb) *linear_rgb = cached_linear_reference(scene, width, height, spp, seed, linear_file, source, report);
+    if (linear_rgb)
+        *linear_rgb = cached_linear_reference(scene, width, height, spp, seed, tone, linear_file, source, display_rgb,
+                                              rgb_file, report);
     if (!save_png.empty()) write_png_display(save_png, Image{width, height, 3, display_rgb, {}});
     if (fs::exists(latent_file)) {
         Image latent = read_fit_image(latent_file, channels, width / f, height / f);

@@ -82,8 +82,9 @@ std::string reference_source(const Scene& scene, const std::map<std::string, std
 /// (two scenes or sequences of one name sharing a cache folder). The latent file records `source`
 /// and `encoder` (vae_encoder_fingerprint); one another VAE encoded is encoded again. A cached EXR
 /// without the display mark or the records (written before EXRs had them) is rewritten with them,
-/// its pixels unchanged. A traced reference's linear values go to `cache_stem`_linear.exr too;
-/// `linear_rgb` (if given) receives them, traced again where the cache lacks them.
+/// its pixels unchanged. `linear_rgb` (if given) receives the values before the display mapping,
+/// kept in `cache_stem`_linear.exr: traced again where the cache lacks them, refused where they do
+/// not map to the cached display values.
 std::vector<float> cached_encoded_reference(const Scene& scene, int width, int height, int spp, uint64_t seed,
                                             const std::string& tone, const Vae& vae, const std::string& cache_stem,
                                             const std::string& source, const std::string& encoder,

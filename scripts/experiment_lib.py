@@ -166,7 +166,7 @@ def settings_line(c):
             f"{dropout}), "
             f"parameterisation {c.get('param', 'code')}, emission decay {c.get('emission_decay', 0):g}, "
             f"emitter response decay {c.get('emitter_response_decay', 0):g}"
-            f"{', light exposures ' + ','.join(f'{k:g}' for k in c['exposures']) if c.get('exposures') else ''}, "
+            f"{', light exposures ' + ','.join(repr(float(k)) for k in c['exposures']) if c.get('exposures') else ''}, "
             f"frames {frames or 'as in the edit files'}"
             f"{f', every {step}th evaluated' if step > 1 else ''}, edited latents {c['spp']} spp")
 
@@ -474,8 +474,10 @@ def fit_argv(c, scene, name, threads, out, iterations=None, final_spp=64, refine
         cmd += ["--emission-decay", repr(float(c["emission_decay"]))]
     if decay and c.get("emitter_response_decay", 0):
         cmd += ["--emitter-response-decay", repr(float(c["emitter_response_decay"]))]
-    if decay and c.get("exposures"):
-        cmd += ["--exposures", ",".join(f"{k:g}" for k in c["exposures"])]
+    # the training reference's scratch fit too: it then traces the linear values the exposures'
+    # targets scale, once, before the fits that read them
+    if c.get("exposures"):
+        cmd += ["--exposures", ",".join(repr(float(k)) for k in c["exposures"])]
     # named only when not the default, never over a fit's own (the baseline's classic), and not
     # in the training-reference job's scratch fit (`decay` False), whose command stays as it was
     if decay and c.get("param", "code") != "code" and "--param" not in extra:

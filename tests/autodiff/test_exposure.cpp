@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 using namespace lpt;
 
@@ -45,17 +46,21 @@ double weighted_render(LatentModel& m, const RenderOptions& o, const std::vector
     return l;
 }
 
+enum class Adjoint { Traced, Stored, StoredAtExposure1 };
+
 /// What fit_latent does at an iteration of exposure k, with d_image = W: the renderer's adjoint
-/// at k·L̃e, then d/dL̃e = k·d/d(k·L̃e). With `stored`, the adjoint of stored paths.
+/// at k·L̃e, then d/dL̃e = k·d/d(k·L̃e). Stored: the adjoint of paths stored at this exposure or,
+/// as within a block of stored paths whose first iteration had another, at exposure 1.
 std::vector<float> exposure_gradient(LatentModel& m, const RenderOptions& o, const std::vector<float>& w, float k,
-                                     bool stored) {
+                                     Adjoint adjoint) {
     m.params().zero_grad();
+    std::vector<float> linear;
+    std::optional<PathRecords> records;
+    if (adjoint == Adjoint::StoredAtExposure1) records = record_latent_paths(m, o, &linear);
     m.scale_emission(k);
-    if (stored) {
-        std::vector<float> linear;
-        const PathRecords records = record_latent_paths(m, o, &linear);
-        replay_backward(m, records, w);
-    } else backward_latent(m, o, w);
+    if (adjoint == Adjoint::Stored) records = record_latent_paths(m, o, &linear);
+    if (records) replay_backward(m, *records, w);
+    else backward_latent(m, o, w);
     scale_emission_gradients(m.params(), k);
     m.sync();
     return m.params().grad_values();
@@ -129,15 +134,18 @@ TEST(Exposure, ScaledLightsRenderKTimesIeAndSyncRestoresThem) {
 
 TEST(Exposure, GradientsMatchCentralDifferencesTracedAndStored) {
     Scene scene = small_cornell();
-    LatentModel m(scene, Parameterisation::Code, 2);
     const RenderOptions o = options(scene);
     const std::vector<float> w = test::random_weights(size_t(kRes) * kRes * kLatentChannels, 5);
-    for (float k : {0.5f, 2.f})
-        for (bool stored : {false, true}) {
-            const std::vector<float> grad = exposure_gradient(m, o, w, k, stored);
-            EXPECT_GT(expect_matches_central_differences(m, o, w, k, grad), 0)
-                << "no light derivative was far from 0: the light's factor k went untested";
-        }
+    // Gain: L̃e = e^g·u, whose map's derivative comes after the factor k
+    for (Parameterisation p : {Parameterisation::Code, Parameterisation::Gain}) {
+        LatentModel m(scene, p, 2);
+        for (float k : {0.5f, 2.f})
+            for (Adjoint adjoint : {Adjoint::Traced, Adjoint::Stored, Adjoint::StoredAtExposure1}) {
+                const std::vector<float> grad = exposure_gradient(m, o, w, k, adjoint);
+                EXPECT_GT(expect_matches_central_differences(m, o, w, k, grad), 0)
+                    << "no light derivative was far from 0: the light's factor k went untested";
+            }
+    }
 }
 
 TEST(Exposure, CycleTeachesTheLightsResponseOneViewLeavesOpen) {

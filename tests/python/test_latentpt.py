@@ -397,7 +397,8 @@ class PipelineTest(unittest.TestCase):
                 latentpt.fit(BOX, cancelled, no_such_option=1)
             with self.assertRaisesRegex(TypeError, "option 'iterations' cannot be a str"):
                 latentpt.fit(BOX, cancelled, synthetic_res="8x8", iterations="10")
-            for bad, flag in (({"spp": -3}, "--spp"), ({"lr_period": 0}, "--lr-period")):
+            for bad, flag in (({"spp": -3}, "--spp"), ({"lr_period": 0}, "--lr-period"),
+                              ({"exposures": [1, 0]}, "--exposures"), ({"exposures": [1, 2]}, "needs --encode")):
                 with self.assertRaisesRegex(ValueError, flag):  # the fit's own checks, not only the CLI's
                     latentpt.fit(BOX, os.path.join(d, "never"), synthetic_res="8x8", refiner=False, **bad)
             self.assertFalse(os.path.exists(os.path.join(d, "never", "params.json")))

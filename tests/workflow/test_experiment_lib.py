@@ -76,13 +76,15 @@ class Preset(unittest.TestCase):
         c = X.settings(paper=True, emission_decay=1e-4, emitter_response_decay=0)
         self.assertIn("--emission-decay 0.0001", X.fit_command(c, "cbox-specular", "ea", 2))
         self.assertNotIn("--emitter-response-decay", X.fit_command(c, "cbox-specular", "ea", 2))
-        # the exposure cycle: every ablation fit's, never the training reference's scratch fit
+        # the exposure cycle: every fit's, the training reference's scratch fit too (it traces the
+        # linear values once); named only when given, so earlier runs' commands stay as they were
         self.assertNotIn("--exposures", X.fit_command(X.settings(paper=True), "cbox-specular", "ea", 2))
-        c = X.settings(paper=True, exposures=[1, 0.5, 1, 2])
+        self.assertNotIn("--exposures", X.training_reference_command(X.settings(paper=True), "cbox-specular", 2))
+        c = X.settings(paper=True, exposures=[1, 0.5, 1, 2.0000001])
         for fit in ("e", "ea", "eac"):
-            self.assertIn("--exposures 1,0.5,1,2", X.fit_command(c, "cbox-specular", fit, 2))
-        self.assertNotIn("--exposures", X.training_reference_command(c, "cbox-specular", 2))
-        self.assertIn("light exposures 1,0.5,1,2", X.settings_line(c))
+            self.assertIn("--exposures 1.0,0.5,1.0,2.0000001", X.fit_command(c, "cbox-specular", fit, 2))
+        self.assertIn("--exposures 1.0,0.5,1.0,2.0000001", X.training_reference_command(c, "cbox-specular", 2))
+        self.assertIn("light exposures 1.0,0.5,1.0,2.0000001", X.settings_line(c))
         # the parameterisation: named only when not code, never over the baseline's own classic
         self.assertNotIn("--param", X.fit_command(X.settings(paper=True), "cbox-specular", "ea", 2))
         gain = X.settings(param="gain")
