@@ -7,6 +7,7 @@
 #include "core/json_number.h"
 #include "core/sampler.h"
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -107,6 +108,13 @@ float exposure_at(const FitOptions& o, int iteration) {
     return o.exposures.empty() ? 1.f : o.exposures[size_t(iteration) % o.exposures.size()];
 }
 
+std::vector<float> exposures_other_than_1(const std::vector<float>& exposures) {
+    std::vector<float> out;
+    for (float k : exposures)
+        if (k != 1.f && std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+    return out;
+}
+
 void scale_emission_gradients(ParamStore& ps, float k) {
     for (size_t s = 0; s < ps.slice_count(); ++s) {
         if (ps.slice(int(s)).kind != "Le") continue;
@@ -135,12 +143,21 @@ void check_target(const std::vector<float>& target, size_t n, float exposure) {
                                     std::to_string(bad_index % kLatentChannels) + ") is not finite");
 }
 
-/// Calls model->sync() when it goes out of scope (unless null).
-struct ResyncOnExit {
-    LatentModel* model;
-    ~ResyncOnExit() {
-        if (model) model->sync();
+/// Gives a model whose lights scale_emission scaled the parameters' lights back: now(), or when it
+/// goes out of scope (an exception) if not yet. Null: nothing to give back.
+class ResyncOnExit {
+public:
+    explicit ResyncOnExit(LatentModel* model) : m_model(model) {}
+    ResyncOnExit(const ResyncOnExit&) = delete;
+    ResyncOnExit& operator=(const ResyncOnExit&) = delete;
+    ~ResyncOnExit() { now(); }
+    void now() {
+        if (m_model) m_model->sync();
+        m_model = nullptr;
     }
+
+private:
+    LatentModel* m_model;
 };
 
 /// targets[i] for each position of the exposure cycle; throws naming an exposure without one.
@@ -201,7 +218,7 @@ FitState fit_latent(LatentModel& model, const std::vector<ExposureTarget>& targe
         const std::vector<float>& target = *cycle[size_t(it) % cycle.size()];
         if (exposure != 1.f) model.scale_emission(exposure);
         // an exception below leaves no model with scaled lights behind
-        const ResyncOnExit resync{exposure != 1.f ? &model : nullptr};
+        ResyncOnExit resync(exposure != 1.f ? &model : nullptr);
         // Primal: docs/fitting.md (7) on the tone-mapped latent.
         std::vector<float> linear;
         if (K == 0)
@@ -220,7 +237,7 @@ FitState fit_latent(LatentModel& model, const std::vector<ExposureTarget>& targe
         else replay_backward(model, *records, d_image);
         if (exposure != 1.f) {
             scale_emission_gradients(ps, exposure);
-            model.sync();  // the lights as the parameters say, for the decays and the step
+            resync.now();  // the lights as the parameters say, for the decays and the step
         }
         loss += add_emission_decay(ps, o.emission_decay) + add_emitter_response_decay(ps, o.emitter_response_decay);
         ps.backward();

@@ -105,6 +105,9 @@ FitState fit_latent(LatentModel& model, const std::vector<ExposureTarget>& targe
                     const std::function<bool(const FitRecord&, const FitState&)>& on_iteration = {});
 /// The light exposure iteration `iteration` fits: options.exposures cycled, 1 if empty.
 float exposure_at(const FitOptions& options, int iteration);
+/// The distinct values of `exposures` other than 1, in their first order: the exposures that need
+/// a target of their own (none: the fit is the training view's alone).
+std::vector<float> exposures_other_than_1(const std::vector<float>& exposures);
 /// Turns the gradients of a render with every light's L̃e times k into those of L̃e itself:
 /// d/dL̃e = k · d/d(k·L̃e) on every "Le" slice.
 void scale_emission_gradients(ParamStore& params, float k);

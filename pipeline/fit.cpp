@@ -33,14 +33,6 @@ struct Target {
     std::vector<ExposureTarget> exposed;
 };
 
-/// The distinct values of `exposures` other than 1, in their first order.
-std::vector<float> exposures_other_than_1(const std::vector<float>& exposures) {
-    std::vector<float> out;
-    for (float k : exposures)
-        if (k != 1.f && std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
-    return out;
-}
-
 Target load_target_exr(const std::string& path) {
     Image img = read_image(path);
     if (img.channels != kLatentChannels)
@@ -62,14 +54,15 @@ Target encoded_target(const FitJob& job, const Scene& scene, const Vae& vae, con
     std::string cached;
     if (!job.reference_cache.empty())
         cached = (fs::path(job.reference_cache) / training_reference_key(iw, ih, job.ref_spp, job.ref_tone)).string();
-    const bool exposed = !exposures_other_than_1(job.options.exposures).empty();
+    const std::vector<float> exposures = exposures_other_than_1(job.options.exposures);
     t.data = cached_encoded_reference(scene, iw, ih, job.ref_spp, kReferenceSeed, job.ref_tone, vae, cached,
                                       reference_source(scene, job.defines), vae_encoder_fingerprint(job.vae),
-                                      (out / "reference.png").string(), ref_rgb, report, exposed ? &linear : nullptr);
+                                      (out / "reference.png").string(), ref_rgb, report,
+                                      exposures.empty() ? nullptr : &linear);
     write_exr((out / "reference_rgb.exr").string(), Image{iw, ih, 3, ref_rgb, {"R", "G", "B"}, true});
     t.width = iw / 8;
     t.height = ih / 8;
-    for (float k : exposures_other_than_1(job.options.exposures)) {
+    for (float k : exposures) {
         // k·I display-mapped: a light's own pixels stay clipped, the room's light scales
         std::vector<float> rgb(linear.size());
         for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = display_value(k * linear[i], job.ref_tone);

@@ -2,7 +2,6 @@
 #include "core/fingerprint.h"
 #include "core/image_io.h"
 #include "pipeline/fit_folder.h"
-#include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 
@@ -40,9 +39,7 @@ nlohmann::json stage1_settings(const FitJob& job) {
                      {"emission_decay", o.emission_decay},
                      {"emitter_response_decay", o.emitter_response_decay},
                      // [1], [1, 1] fit as [] does: recorded as [], as checkpoints without a cycle have it
-                     {"exposures", std::all_of(o.exposures.begin(), o.exposures.end(), [](float k) { return k == 1.f; })
-                                       ? std::vector<float>{}
-                                       : o.exposures},
+                     {"exposures", exposures_other_than_1(o.exposures).empty() ? std::vector<float>{} : o.exposures},
                      {"patience", o.patience},
                      {"min_delta", o.min_delta},
                      {"smoothing", o.smoothing},
